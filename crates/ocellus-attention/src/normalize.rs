@@ -1,0 +1,135 @@
+//! The competition operator N(.) (SPEC 1.6): iterative difference of Gaussians
+//! (Itti & Koch 2001), the local-maxima rule of Itti et al. 1998, or none.
+
+use crate::config::{GlobalInhibition, Normalization};
+use crate::Result;
+use ocellus_image::filter::PreservingFilter;
+use ocellus_image::{Backend, Plane};
+
+/// 1D Gaussian `peak * exp(-i^2 / (2 sigma^2))` for `i = -hw..=hw`, with `hw` where it falls
+/// below 1 % of the peak: `floor(sigma * sqrt(-2 ln 0.01))` (seed eq. 18), capped at `max_hw`
+/// when `max_hw > 0`.
+pub fn gaussian_kernel(peak: f32, sigma: f32, max_hw: usize) -> Vec<f32> {
+    let mut hw = (sigma as f64 * (-2.0 * 0.01f64.ln()).sqrt()).floor() as usize;
+    if max_hw > 0 && hw > max_hw {
+        hw = max_hw;
+    }
+    let s2 = 2.0 * (sigma as f64) * (sigma as f64);
+    (-(hw as isize)..=hw as isize).map(|i| (peak as f64 * (-((i * i) as f64) / s2).exp()) as f32).collect()
+}
+
+/// Linearly maps the map's [min, max] to [0, range]; a flat map becomes `range / 2`
+/// everywhere (SaliencyToolbox `normalizeImage`).
+pub fn scale_to_range(map: &mut Plane<f32>, range: f32) {
+    let (mn, mx) = map.min_max();
+    for y in 0..map.height() {
+        let row = map.row_mut(y);
+        if mx > mn {
+            let s = range / (mx - mn);
+            row.iter_mut().for_each(|v| *v = (*v - mn) * s);
+        } else {
+            row.fill(0.5 * range);
+        }
+    }
+}
+
+fn clamp_negative(map: &mut Plane<f32>) {
+    for y in 0..map.height() {
+        map.row_mut(y).iter_mut().for_each(|v| *v = v.max(0.0));
+    }
+}
+
+/// N(.) for maps of one size; owns its filters and buffers.
+#[derive(Debug, Clone)]
+pub struct Normalizer {
+    kind: Normalization,
+    excitation: Option<PreservingFilter>,
+    inhibition: Option<PreservingFilter>,
+    excit: Plane<f32>,
+    inhib: Plane<f32>,
+}
+
+impl Normalizer {
+    /// Builds N(.) for `width` x `height` maps.
+    pub fn new(kind: &Normalization, width: usize, height: usize) -> Result<Self> {
+        let (mut excitation, mut inhibition) = (None, None);
+        if let Normalization::Iterative { excitation_sigma_frac, inhibition_sigma_frac, c_excitation, c_inhibition, .. } = kind {
+            let sz = width.max(height) as f32;
+            let max_hw = (width.min(height) / 2).saturating_sub(1);
+            let (es, is) = (sz * excitation_sigma_frac, sz * inhibition_sigma_frac);
+            let root = (2.0 * std::f32::consts::PI).sqrt();
+            excitation = Some(PreservingFilter::new(&gaussian_kernel(c_excitation / (es * root), es, max_hw), width, height)?);
+            inhibition = Some(PreservingFilter::new(&gaussian_kernel(c_inhibition / (is * root), is, max_hw), width, height)?);
+        }
+        Ok(Self { kind: kind.clone(), excitation, inhibition, excit: Plane::new(width, height), inhib: Plane::new(width, height) })
+    }
+
+    /// Applies N(.) in place: clamp at 0, scale to `[0, range]` when `range` is given, then
+    /// compete. The result is finite and non-negative for any finite input.
+    pub fn apply(&mut self, backend: Backend, map: &mut Plane<f32>, range: Option<f32>) -> Result<()> {
+        clamp_negative(map);
+        if let Some(r) = range {
+            scale_to_range(map, r);
+        }
+        match &self.kind {
+            Normalization::None => Ok(()),
+            Normalization::LocalMax => {
+                local_max(map, range);
+                Ok(())
+            }
+            Normalization::Iterative { iterations, global_inhibition, .. } => {
+                let (Some(ex), Some(inh)) = (self.excitation.as_mut(), self.inhibition.as_mut()) else {
+                    return Ok(());
+                };
+                for _ in 0..*iterations {
+                    ex.apply(backend, map, &mut self.excit)?;
+                    inh.apply(backend, map, &mut self.inhib)?;
+                    let c = match *global_inhibition {
+                        GlobalInhibition::Constant(c) => c,
+                        GlobalInhibition::RelativeToMax(f) => f * map.min_max().1,
+                    };
+                    for y in 0..map.height() {
+                        let (e, i) = (self.excit.row(y), self.inhib.row(y));
+                        for (x, v) in map.row_mut(y).iter_mut().enumerate() {
+                            *v = (*v + e[x] - i[x] - c).max(0.0);
+                        }
+                    }
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+/// Itti et al. 1998: multiply by `(M - mean of local maxima)^2`, M the range's top (or the
+/// map maximum without a range). Local maxima: interior pixels >= their 4 neighbours and
+/// >= a tenth of the range (SaliencyToolbox `maxNormalizeLocalMax`). With one maximum the
+/// factor is `M^2`; with none the map is left as is.
+fn local_max(map: &mut Plane<f32>, range: Option<f32>) {
+    let (thresh, gmax) = match range {
+        Some(r) => (r / 10.0, r),
+        None => (1.0, map.min_max().1),
+    };
+    let (w, h) = map.size();
+    let (mut n, mut sum) = (0usize, 0f64);
+    for y in 1..h.saturating_sub(1) {
+        for x in 1..w.saturating_sub(1) {
+            let v = map.get(x, y);
+            if v >= thresh && v >= map.get(x - 1, y) && v >= map.get(x + 1, y) && v >= map.get(x, y - 1) && v >= map.get(x, y + 1) {
+                n += 1;
+                sum += v as f64;
+            }
+        }
+    }
+    let f = match n {
+        0 => 1.0,
+        1 => gmax * gmax,
+        _ => {
+            let d = gmax - (sum / n as f64) as f32;
+            d * d
+        }
+    };
+    for y in 0..h {
+        map.row_mut(y).iter_mut().for_each(|v| *v *= f);
+    }
+}

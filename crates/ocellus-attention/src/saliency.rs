@@ -1,0 +1,532 @@
+//! The saliency engine: input frame to saliency map (SPEC 1), with every intermediate kept.
+//!
+//! Build once per frame size with [`SaliencyEngine::new`]; [`SaliencyEngine::process`]
+//! reuses all buffers, so steady state allocates nothing.
+
+use crate::center_surround::{abs_difference, attenuate_borders, ramp_width, scale_pairs, ScalePair};
+use crate::channels::{opponent_from_planes, opponent_planes, skin_plane, split_rgb};
+use crate::config::{ChannelKind, Combination, OpponencyStage, SaliencyConfig};
+use crate::gabor::GaborBank;
+use crate::normalize::Normalizer;
+use crate::{AttentionError, Result};
+use ocellus_image::convert::RgbImage;
+use ocellus_image::pyramid::{level_sizes, pyr_down, PyrScratch};
+use ocellus_image::resample::{ResampleMethod, Resampler};
+use ocellus_image::{Backend, Plane};
+use std::time::{Duration, Instant};
+
+/// Where a sub-feature's pyramid comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Source {
+    /// Intensity.
+    Intensity,
+    /// Red-green opponency.
+    RedGreen,
+    /// Blue-yellow opponency.
+    BlueYellow,
+    /// Gabor energy at the orientation with this index in `gabor.angles_deg`.
+    Orientation(usize),
+    /// Skin likelihood.
+    Skin,
+    /// The n-th external map.
+    External(usize),
+}
+
+/// One sub-feature: a pyramid whose center-surround maps are normalized together.
+#[derive(Clone, Debug)]
+pub struct SubFeature {
+    /// Index of its channel in `config.channels`.
+    pub channel: usize,
+    /// What it is computed from.
+    pub source: Source,
+    /// Readable name (e.g. "orientation 45").
+    pub label: String,
+}
+
+/// A center-surround feature map (before normalization), at the map level.
+#[derive(Clone, Debug, Default)]
+pub struct FeatureMap {
+    /// Index into [`SaliencyEngine::subfeatures`].
+    pub subfeature: usize,
+    /// Centre level.
+    pub center: usize,
+    /// Surround level.
+    pub surround: usize,
+    /// `|C(c) - S(s)|` (border-attenuated when configured).
+    pub map: Plane<f32>,
+}
+
+/// Wall time per stage of the last frame (SPEC 1.9, the seed's Table 4.1 stages).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageTimings {
+    /// u8 to float, colour and intensity maps, Gaussian pyramids.
+    pub pyramid: Duration,
+    /// Gabor filtering.
+    pub orientation: Duration,
+    /// Bringing levels to the map level.
+    pub rescale: Duration,
+    /// |c - s| and border ramp.
+    pub center_surround: Duration,
+    /// N(.) on feature, sub-feature and channel maps.
+    pub normalization: Duration,
+    /// Sums, weights, final map.
+    pub combination: Duration,
+}
+
+impl StageTimings {
+    /// Stage names and durations, in pipeline order.
+    pub fn stages(&self) -> [(&'static str, Duration); 6] {
+        [
+            ("pyramid_and_colour", self.pyramid),
+            ("orientation", self.orientation),
+            ("rescale", self.rescale),
+            ("center_surround", self.center_surround),
+            ("normalization", self.normalization),
+            ("combination", self.combination),
+        ]
+    }
+
+    /// Sum of all stages.
+    pub fn total(&self) -> Duration {
+        self.stages().iter().map(|s| s.1).sum()
+    }
+}
+
+/// Computes saliency maps for frames of one size.
+#[derive(Debug)]
+pub struct SaliencyEngine {
+    cfg: SaliencyConfig,
+    backend: Backend,
+    width: usize,
+    height: usize,
+    sizes: Vec<(usize, usize)>,
+    pairs: Vec<ScalePair>,
+    used_levels: Vec<usize>,
+    subs: Vec<SubFeature>,
+    n_external: usize,
+    // pyramids, levels 0..=max_level; levels a source does not need stay empty
+    rgb: [Vec<Plane<f32>>; 3],
+    opp: [Vec<Plane<f32>>; 3],
+    ori: Vec<Vec<Plane<f32>>>,
+    skin: Vec<Plane<f32>>,
+    external: Vec<Vec<Plane<f32>>>,
+    pyr_scratch: PyrScratch,
+    gabor: Option<GaborBank>,
+    resamplers: Vec<Option<Resampler>>,
+    external_resamplers: Vec<Option<Resampler>>,
+    rescaled: Vec<Vec<Plane<f32>>>,
+    features: Vec<FeatureMap>,
+    normalizer: Normalizer,
+    tmp: Plane<f32>,
+    sub_sum: Plane<f32>,
+    conspicuity: Vec<Plane<f32>>,
+    saliency: Plane<f32>,
+    prior: Option<Plane<f32>>,
+    upsampler: Option<Resampler>,
+    timings: StageTimings,
+}
+
+fn empty_pyr(n: usize) -> Vec<Plane<f32>> {
+    (0..n).map(|_| Plane::default()).collect()
+}
+
+impl SaliencyEngine {
+    /// Validates `cfg` and allocates everything for `width` x `height` frames.
+    pub fn new(cfg: SaliencyConfig, width: usize, height: usize) -> Result<Self> {
+        cfg.validate()?;
+        let max_level = cfg.max_level();
+        let min_side = 1usize << max_level;
+        if width < min_side || height < min_side {
+            return Err(AttentionError::TooSmall { width, height, levels: max_level + 1, min_side });
+        }
+        let sizes = level_sizes(width, height, max_level + 1);
+        let pairs = scale_pairs(&cfg.center_levels, &cfg.deltas);
+        let mut used_levels: Vec<usize> = pairs.iter().flat_map(|p| [p.center, p.surround]).collect();
+        used_levels.sort_unstable();
+        used_levels.dedup();
+
+        let mut subs = Vec::new();
+        let mut n_external = 0;
+        for (ci, ch) in cfg.channels.iter().enumerate() {
+            let mut push = |source, label: String| subs.push(SubFeature { channel: ci, source, label });
+            match &ch.kind {
+                ChannelKind::Intensity => push(Source::Intensity, "intensity".into()),
+                ChannelKind::Color => {
+                    push(Source::RedGreen, "red-green".into());
+                    push(Source::BlueYellow, "blue-yellow".into());
+                }
+                ChannelKind::Orientation => {
+                    for (a, deg) in cfg.gabor.angles_deg.iter().enumerate() {
+                        push(Source::Orientation(a), format!("orientation {deg}"));
+                    }
+                }
+                ChannelKind::Skin => push(Source::Skin, "skin".into()),
+                ChannelKind::External(name) => {
+                    push(Source::External(n_external), format!("external {name}"));
+                    n_external += 1;
+                }
+            }
+        }
+        let has = |k: &ChannelKind| cfg.channels.iter().any(|c| &c.kind == k);
+        let n = max_level + 1;
+        let map_size = sizes[cfg.map_level];
+        let mut resamplers = Vec::with_capacity(n);
+        for (l, &s) in sizes.iter().enumerate() {
+            resamplers.push(if used_levels.contains(&l) { Some(Resampler::new(cfg.across_scale, s, map_size)?) } else { None });
+        }
+        let gabor = has(&ChannelKind::Orientation).then(|| GaborBank::new(&cfg.gabor));
+        let n_angles = cfg.gabor.angles_deg.len();
+        let normalizer = Normalizer::new(&cfg.normalization, map_size.0, map_size.1)?;
+        let features = pairs
+            .iter()
+            .enumerate()
+            .flat_map(|(_, p)| (0..subs.len()).map(move |s| (s, *p)))
+            .map(|(s, p)| FeatureMap { subfeature: s, center: p.center, surround: p.surround, map: Plane::new(map_size.0, map_size.1) })
+            .collect::<Vec<_>>();
+        // Order feature maps by sub-feature, then pair, for readable listings.
+        let mut features = features;
+        features.sort_by_key(|f| (f.subfeature, f.center, f.surround));
+        Ok(Self {
+            backend: cfg.backend.resolve(),
+            width,
+            height,
+            sizes,
+            rgb: [empty_pyr(n), empty_pyr(n), empty_pyr(n)],
+            opp: [empty_pyr(n), empty_pyr(n), empty_pyr(n)],
+            ori: (0..n).map(|_| empty_pyr(n_angles)).collect(),
+            skin: empty_pyr(n),
+            external: (0..n_external).map(|_| empty_pyr(n)).collect(),
+            pyr_scratch: PyrScratch::default(),
+            gabor,
+            resamplers,
+            external_resamplers: vec![None; n_external],
+            rescaled: (0..subs.len()).map(|_| empty_pyr(n)).collect(),
+            features,
+            normalizer,
+            tmp: Plane::new(map_size.0, map_size.1),
+            sub_sum: Plane::new(map_size.0, map_size.1),
+            conspicuity: (0..cfg.channels.len()).map(|_| Plane::new(map_size.0, map_size.1)).collect(),
+            saliency: Plane::new(map_size.0, map_size.1),
+            prior: None,
+            upsampler: None,
+            timings: StageTimings::default(),
+            pairs,
+            used_levels,
+            subs,
+            n_external,
+            cfg,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &SaliencyConfig {
+        &self.cfg
+    }
+
+    /// Frame size (width, height) this engine was built for.
+    pub fn frame_size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// Size (width, height) of the feature, conspicuity and saliency maps.
+    pub fn map_size(&self) -> (usize, usize) {
+        self.sizes[self.cfg.map_level]
+    }
+
+    /// The backend that runs the kernels.
+    pub fn backend(&self) -> Backend {
+        self.backend
+    }
+
+    /// Sets a spatial prior (top-down location bias, SPEC 1.8): the final saliency map is
+    /// multiplied by it after resampling it (bilinear) to the map size. Values should be
+    /// in [0, 1]; non-finite or negative values are an error.
+    pub fn set_spatial_prior(&mut self, prior: Option<&Plane<f32>>) -> Result<()> {
+        self.prior = match prior {
+            None => None,
+            Some(p) => {
+                if p.is_empty() || !p.all_finite() || p.min_max().0 < 0.0 {
+                    return Err(AttentionError::InvalidInput("spatial prior must be non-empty, finite and non-negative".into()));
+                }
+                let (w, h) = self.map_size();
+                let mut out = Plane::default();
+                Resampler::new(ResampleMethod::Bilinear, p.size(), (w, h))?.apply(p, &mut out)?;
+                Some(out)
+            }
+        };
+        Ok(())
+    }
+
+    /// Computes the saliency map of `frame`; returns it at the map level.
+    pub fn process(&mut self, frame: &RgbImage) -> Result<&Plane<f32>> {
+        self.process_with_maps(frame, &[])
+    }
+
+    /// Like [`process`](Self::process), with one map per `External` channel (in channel
+    /// order), each of any size (resampled to pyramid level `min(center_levels)`).
+    pub fn process_with_maps(&mut self, frame: &RgbImage, external: &[&Plane<f32>]) -> Result<&Plane<f32>> {
+        let (w, h) = frame.size();
+        if (w, h) != (self.width, self.height) {
+            return Err(AttentionError::FrameSize { width: w, height: h, want_w: self.width, want_h: self.height });
+        }
+        if external.len() != self.n_external {
+            return Err(AttentionError::InvalidInput(format!("{} external maps given, the configuration has {} external channels", external.len(), self.n_external)));
+        }
+        for m in external {
+            if m.is_empty() || !m.all_finite() {
+                return Err(AttentionError::InvalidInput(format!("external map of {}x{} is empty or has non-finite values", m.width(), m.height())));
+            }
+        }
+        let t0 = Instant::now();
+        self.build_pyramids(frame, external)?;
+        let t1 = Instant::now();
+        self.build_orientations()?;
+        let t2 = Instant::now();
+        self.rescale()?;
+        let t3 = Instant::now();
+        self.center_surround();
+        let t4 = Instant::now();
+        let (norm, comb) = self.normalize_and_combine()?;
+        self.timings = StageTimings { pyramid: t1 - t0, orientation: t2 - t1, rescale: t3 - t2, center_surround: t4 - t3, normalization: norm, combination: comb };
+        Ok(&self.saliency)
+    }
+
+    fn max_level(&self) -> usize {
+        self.sizes.len() - 1
+    }
+
+    fn pyramid_up(backend: Backend, pyr: &mut [Plane<f32>], from: usize, to: usize, k: &ocellus_image::pyramid::PyramidKernel, s: &mut PyrScratch) -> Result<()> {
+        for l in from..to {
+            let (lo, hi) = pyr.split_at_mut(l + 1);
+            pyr_down(backend, &lo[l], &mut hi[0], k, s)?;
+        }
+        Ok(())
+    }
+
+    fn build_pyramids(&mut self, frame: &RgbImage, external: &[&Plane<f32>]) -> Result<()> {
+        let (b, top) = (self.backend, self.max_level());
+        let cfg = &self.cfg;
+        let needs = |k: ChannelKind| cfg.channels.iter().any(|c| c.kind == k);
+        let need_i = needs(ChannelKind::Intensity) || needs(ChannelKind::Orientation);
+        let need_c = needs(ChannelKind::Color);
+        let weights = cfg.intensity.weights();
+        if need_i || need_c {
+            match cfg.opponency_at {
+                OpponencyStage::Input => {
+                    let [i, rg, by] = &mut self.opp;
+                    opponent_planes(b, frame, weights, cfg.color_threshold, [&mut i[0], &mut rg[0], &mut by[0]]);
+                    for (k, p) in self.opp.iter_mut().enumerate() {
+                        if (k == 0 && need_i) || (k > 0 && need_c) {
+                            Self::pyramid_up(b, p, 0, top, &cfg.pyramid, &mut self.pyr_scratch)?;
+                        }
+                    }
+                }
+                OpponencyStage::EachLevel => {
+                    let [r, g, bl] = &mut self.rgb;
+                    split_rgb(b, frame, [&mut r[0], &mut g[0], &mut bl[0]]);
+                    for p in self.rgb.iter_mut() {
+                        Self::pyramid_up(b, p, 0, top, &cfg.pyramid, &mut self.pyr_scratch)?;
+                    }
+                    for &l in &self.used_levels {
+                        let [i, rg, by] = &mut self.opp;
+                        opponent_from_planes([&self.rgb[0][l], &self.rgb[1][l], &self.rgb[2][l]], weights, cfg.color_threshold, [&mut i[l], &mut rg[l], &mut by[l]]);
+                    }
+                }
+            }
+        }
+        if needs(ChannelKind::Skin) {
+            skin_plane(frame, cfg.color_threshold, &mut self.skin[0]);
+            Self::pyramid_up(b, &mut self.skin, 0, top, &cfg.pyramid, &mut self.pyr_scratch)?;
+        }
+        let base = self.used_levels.first().copied().unwrap_or(0);
+        for (k, m) in external.iter().enumerate() {
+            let target = self.sizes[base];
+            let rs = match &self.external_resamplers[k] {
+                Some(r) if r.dst_size() == target && self.external[k][base].size() == target => r,
+                _ => {
+                    self.external_resamplers[k] = Some(Resampler::new(ResampleMethod::Bilinear, m.size(), target)?);
+                    self.external_resamplers[k].as_ref().ok_or_else(|| AttentionError::InvalidInput("resampler".into()))?
+                }
+            };
+            if rs.apply(m, &mut self.external[k][base]).is_err() {
+                let r = Resampler::new(ResampleMethod::Bilinear, m.size(), target)?;
+                r.apply(m, &mut self.external[k][base])?;
+                self.external_resamplers[k] = Some(r);
+            }
+            Self::pyramid_up(b, &mut self.external[k], base, top, &cfg.pyramid, &mut self.pyr_scratch)?;
+        }
+        Ok(())
+    }
+
+    fn build_orientations(&mut self) -> Result<()> {
+        let Some(g) = self.gabor.as_mut() else { return Ok(()) };
+        for &l in &self.used_levels {
+            g.filter(self.backend, &self.opp[0][l], &mut self.ori[l])?;
+        }
+        Ok(())
+    }
+
+    /// A pyramid level of a source (empty if that level is not computed).
+    pub fn level(&self, source: Source, level: usize) -> Option<&Plane<f32>> {
+        let p = match source {
+            Source::Intensity => self.opp[0].get(level),
+            Source::RedGreen => self.opp[1].get(level),
+            Source::BlueYellow => self.opp[2].get(level),
+            Source::Orientation(a) => self.ori.get(level).and_then(|v| v.get(a)),
+            Source::Skin => self.skin.get(level),
+            Source::External(k) => self.external.get(k).and_then(|v| v.get(level)),
+        }?;
+        (!p.is_empty()).then_some(p)
+    }
+
+    fn rescale(&mut self) -> Result<()> {
+        for s in 0..self.subs.len() {
+            let src = self.subs[s].source;
+            for &l in &self.used_levels {
+                let plane = match src {
+                    Source::Intensity => &self.opp[0][l],
+                    Source::RedGreen => &self.opp[1][l],
+                    Source::BlueYellow => &self.opp[2][l],
+                    Source::Orientation(a) => &self.ori[l][a],
+                    Source::Skin => &self.skin[l],
+                    Source::External(k) => &self.external[k][l],
+                };
+                if let Some(r) = &self.resamplers[l] {
+                    r.apply(plane, &mut self.rescaled[s][l])?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn center_surround(&mut self) {
+        let (w, h) = self.map_size();
+        let ramp = ramp_width(w, h, self.cfg.border_ramp_frac);
+        for f in self.features.iter_mut() {
+            let r = &self.rescaled[f.subfeature];
+            abs_difference(&r[f.center], &r[f.surround], &mut f.map);
+            attenuate_borders(&mut f.map, ramp);
+        }
+    }
+
+    fn normalize_and_combine(&mut self) -> Result<(Duration, Duration)> {
+        let b = self.backend;
+        let mut t_norm = Duration::ZERO;
+        let t_start = Instant::now();
+        let n_channels = self.cfg.channels.len();
+        let range = self.cfg.feature_range;
+        let weight_sum: f32 = self.cfg.channels.iter().map(|c| c.weight).sum();
+        for ci in 0..n_channels {
+            let cm = &mut self.conspicuity[ci];
+            cm.fill(0.0);
+            let mut n_sub = 0usize;
+            for s in 0..self.subs.len() {
+                if self.subs[s].channel != ci {
+                    continue;
+                }
+                n_sub += 1;
+                self.sub_sum.fill(0.0);
+                for f in self.features.iter().filter(|f| f.subfeature == s) {
+                    self.tmp.copy_from(&f.map);
+                    let t = Instant::now();
+                    self.normalizer.apply(b, &mut self.tmp, Some(range))?;
+                    t_norm += t.elapsed();
+                    add_into(&mut self.sub_sum, &self.tmp);
+                }
+                let t = Instant::now();
+                self.normalizer.apply(b, &mut self.sub_sum, None)?;
+                t_norm += t.elapsed();
+                add_into(cm, &self.sub_sum);
+            }
+            if n_sub > 1 {
+                let t = Instant::now();
+                self.normalizer.apply(b, cm, None)?;
+                t_norm += t.elapsed();
+            }
+            let ch = &self.cfg.channels[ci];
+            let factor = match self.cfg.combination {
+                Combination::WeightedMean => ch.weight / weight_sum,
+                Combination::StbPerSubfeature => ch.weight / n_sub.max(1) as f32 / n_channels as f32,
+            };
+            scale(cm, factor);
+        }
+        self.saliency.fill(0.0);
+        for cm in &self.conspicuity {
+            add_into(&mut self.saliency, cm);
+        }
+        if let Some(r) = self.cfg.final_range {
+            let t = Instant::now();
+            self.normalizer.apply(b, &mut self.saliency, Some(r))?;
+            t_norm += t.elapsed();
+        }
+        if let Some(p) = &self.prior {
+            for y in 0..p.height() {
+                let pr = p.row(y);
+                self.saliency.row_mut(y).iter_mut().zip(pr).for_each(|(v, q)| *v *= q);
+            }
+        }
+        Ok((t_norm, t_start.elapsed().saturating_sub(t_norm)))
+    }
+
+    /// The saliency map of the last frame, at the map level.
+    pub fn saliency(&self) -> &Plane<f32> {
+        &self.saliency
+    }
+
+    /// Conspicuity map of channel `i` (order of `config.channels`), after weighting.
+    pub fn conspicuity(&self, i: usize) -> Option<&Plane<f32>> {
+        self.conspicuity.get(i)
+    }
+
+    /// All conspicuity maps with their channel labels.
+    pub fn conspicuity_maps(&self) -> impl Iterator<Item = (String, &Plane<f32>)> {
+        self.cfg.channels.iter().map(|c| c.kind.label()).zip(self.conspicuity.iter())
+    }
+
+    /// The center-surround feature maps (before normalization) of the last frame:
+    /// 42 for the standard channels (6 intensity, 12 colour, 24 orientation).
+    pub fn feature_maps(&self) -> &[FeatureMap] {
+        &self.features
+    }
+
+    /// The sub-features, indexed by [`FeatureMap::subfeature`].
+    pub fn subfeatures(&self) -> &[SubFeature] {
+        &self.subs
+    }
+
+    /// The center-surround level pairs.
+    pub fn scale_pairs(&self) -> &[ScalePair] {
+        &self.pairs
+    }
+
+    /// Per-stage timings of the last frame.
+    pub fn timings(&self) -> StageTimings {
+        self.timings
+    }
+
+    /// The saliency map resampled (bilinear, pixel centres aligned) to the input size.
+    pub fn saliency_full_size(&mut self, out: &mut Plane<f32>) -> Result<()> {
+        let up = match &self.upsampler {
+            Some(u) => u,
+            None => {
+                self.upsampler = Some(Resampler::new(ResampleMethod::Bilinear, self.map_size(), (self.width, self.height))?);
+                self.upsampler.as_ref().ok_or_else(|| AttentionError::InvalidInput("upsampler".into()))?
+            }
+        };
+        up.apply(&self.saliency, out)?;
+        Ok(())
+    }
+}
+
+fn add_into(acc: &mut Plane<f32>, x: &Plane<f32>) {
+    for y in 0..acc.height() {
+        let xr = x.row(y);
+        acc.row_mut(y).iter_mut().zip(xr).for_each(|(a, b)| *a += b);
+    }
+}
+
+fn scale(p: &mut Plane<f32>, f: f32) {
+    for y in 0..p.height() {
+        p.row_mut(y).iter_mut().for_each(|v| *v *= f);
+    }
+}

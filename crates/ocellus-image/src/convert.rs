@@ -1,0 +1,84 @@
+//! Conversions between `image` crate buffers and ocellus planes.
+//!
+//! Every input kind (grey, grey+alpha, RGB, RGBA, 8 or 16 bits, float) becomes an RGB
+//! image; alpha is dropped (not composited), grey is replicated to R = G = B.
+
+use crate::{ImageError, Plane, Result};
+use image::DynamicImage;
+
+/// An RGB image as given to the attention pipeline.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RgbImage {
+    /// 8 bits per channel, interleaved.
+    U8(Plane<[u8; 3]>),
+    /// Float channels in [0, 1], interleaved (from 16-bit or float inputs).
+    F32(Plane<[f32; 3]>),
+}
+
+impl RgbImage {
+    /// (width, height).
+    pub fn size(&self) -> (usize, usize) {
+        match self {
+            RgbImage::U8(p) => p.size(),
+            RgbImage::F32(p) => p.size(),
+        }
+    }
+
+    /// Pixel (x, y) as floats in [0, 1].
+    pub fn get_f32(&self, x: usize, y: usize) -> [f32; 3] {
+        match self {
+            RgbImage::U8(p) => p.get(x, y).map(|v| v as f32 / 255.0),
+            RgbImage::F32(p) => p.get(x, y),
+        }
+    }
+
+    /// 8-bit copy (rounded, saturated), e.g. for overlays.
+    pub fn to_u8(&self) -> Plane<[u8; 3]> {
+        match self {
+            RgbImage::U8(p) => p.clone(),
+            RgbImage::F32(p) => p.map(|c| c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)),
+        }
+    }
+}
+
+/// Converts any decoded image to RGB, keeping 16-bit and float precision.
+pub fn from_dynamic(img: &DynamicImage) -> Result<RgbImage> {
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    if w == 0 || h == 0 {
+        return Err(ImageError::Empty { width: w, height: h });
+    }
+    let high_precision = matches!(
+        img,
+        DynamicImage::ImageLuma16(_) | DynamicImage::ImageLumaA16(_) | DynamicImage::ImageRgb16(_) | DynamicImage::ImageRgba16(_) | DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+    );
+    if high_precision {
+        let buf = img.to_rgb32f();
+        let data = buf.pixels().map(|p| p.0.map(|v| if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 })).collect();
+        Ok(RgbImage::F32(Plane::from_vec(w, h, data)?))
+    } else {
+        let buf = img.to_rgb8();
+        let data = buf.pixels().map(|p| p.0).collect();
+        Ok(RgbImage::U8(Plane::from_vec(w, h, data)?))
+    }
+}
+
+/// An 8-bit RGB plane as an `image` buffer.
+pub fn to_image_rgb8(p: &Plane<[u8; 3]>) -> image::RgbImage {
+    let (w, h) = p.size();
+    image::RgbImage::from_fn(w as u32, h as u32, |x, y| image::Rgb(p.get(x as usize, y as usize)))
+}
+
+/// A float map as an 8-bit grey `image` buffer, linearly scaled so `lo..hi` maps to 0..255.
+pub fn to_image_gray8(p: &Plane<f32>, lo: f32, hi: f32) -> image::GrayImage {
+    let (w, h) = p.size();
+    let span = if hi > lo { hi - lo } else { 1.0 };
+    image::GrayImage::from_fn(w as u32, h as u32, |x, y| {
+        let v = (p.get(x as usize, y as usize) - lo) / span;
+        image::Luma([(v.clamp(0.0, 1.0) * 255.0).round() as u8])
+    })
+}
+
+/// A grey `image` buffer as a float plane in [0, 1].
+pub fn from_image_gray8(img: &image::GrayImage) -> Plane<f32> {
+    Plane::from_fn(img.width() as usize, img.height() as usize, |x, y| img.get_pixel(x as u32, y as u32).0[0] as f32 / 255.0)
+}

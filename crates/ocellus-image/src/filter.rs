@@ -1,0 +1,302 @@
+//! Separable correlation with explicit border rules, and the energy-preserving variant
+//! (kernel truncated at the border and renormalized so the edge creates no false maxima).
+//!
+//! Kernels are correlated, not flipped: `out[x] = sum_t k[t] * in[x + t - hw]` with
+//! `hw = (len - 1) / 2`. For the symmetric and antisymmetric kernels used in ocellus the
+//! difference to convolution is at most a sign.
+
+use crate::simd::Madd;
+use crate::{dispatch_kernel, Backend, ImageError, Plane, Result};
+
+/// What lies outside the image for a filter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Border {
+    /// Zeros (MATLAB's `conv2(..., 'same')`).
+    Zero,
+    /// The nearest edge pixel ("clamp to edge", as the seed's texture fetch).
+    Clamp,
+}
+
+/// Reusable buffers for the separable filters (grow once, then no allocation).
+#[derive(Default, Debug, Clone)]
+pub struct FilterScratch {
+    padded: Vec<f32>,
+    tmp: Plane<f32>,
+    rows: Vec<(usize, f32)>,
+}
+
+const CHUNK: usize = 32;
+
+/// `out[x] = sum_t k[t] * p[x + t]` for `x < out.len()`; `p.len() >= out.len() + k.len() - 1`.
+#[inline(always)]
+pub(crate) fn correlate_padded_generic<M: Madd>(p: &[f32], k: &[f32], out: &mut [f32]) {
+    let n = out.len();
+    let mut x = 0;
+    // Many independent accumulators hide the latency of the multiply-add chain.
+    while x + CHUNK <= n {
+        let mut acc = [0f32; CHUNK];
+        for (t, &kt) in k.iter().enumerate() {
+            let s: &[f32; CHUNK] = p[x + t..x + t + CHUNK].try_into().unwrap_or(&[0.0; CHUNK]);
+            for l in 0..CHUNK {
+                acc[l] = M::madd(kt, s[l], acc[l]);
+            }
+        }
+        out[x..x + CHUNK].copy_from_slice(&acc);
+        x += CHUNK;
+    }
+    while x + 8 <= n {
+        let mut acc = [0f32; 8];
+        for (t, &kt) in k.iter().enumerate() {
+            let s: &[f32; 8] = p[x + t..x + t + 8].try_into().unwrap_or(&[0.0; 8]);
+            for l in 0..8 {
+                acc[l] = M::madd(kt, s[l], acc[l]);
+            }
+        }
+        out[x..x + 8].copy_from_slice(&acc);
+        x += 8;
+    }
+    while x < n {
+        let mut acc = 0f32;
+        for (t, &kt) in k.iter().enumerate() {
+            acc = M::madd(kt, p[x + t], acc);
+        }
+        out[x] = acc;
+        x += 1;
+    }
+}
+
+dispatch_kernel!(
+    /// `out[x] = sum_t k[t] * p[x + t]`: correlation of a pre-padded row.
+    pub fn correlate_padded => correlate_padded_generic(p: &[f32], k: &[f32], out: &mut [f32])
+);
+
+/// `out[x] = sum_i w_i * src.row(r_i)[x]` over `rows = [(r_i, w_i)]`.
+#[inline(always)]
+pub(crate) fn accumulate_rows_generic<M: Madd>(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32]) {
+    let n = out.len();
+    let mut x = 0;
+    while x + CHUNK <= n {
+        let mut acc = [0f32; CHUNK];
+        for &(r, w) in rows {
+            let s: &[f32; CHUNK] = src.row(r)[x..x + CHUNK].try_into().unwrap_or(&[0.0; CHUNK]);
+            for l in 0..CHUNK {
+                acc[l] = M::madd(w, s[l], acc[l]);
+            }
+        }
+        out[x..x + CHUNK].copy_from_slice(&acc);
+        x += CHUNK;
+    }
+    while x + 8 <= n {
+        let mut acc = [0f32; 8];
+        for &(r, w) in rows {
+            let s: &[f32; 8] = src.row(r)[x..x + 8].try_into().unwrap_or(&[0.0; 8]);
+            for l in 0..8 {
+                acc[l] = M::madd(w, s[l], acc[l]);
+            }
+        }
+        out[x..x + 8].copy_from_slice(&acc);
+        x += 8;
+    }
+    while x < n {
+        let mut acc = 0f32;
+        for &(r, w) in rows {
+            acc = M::madd(w, src.row(r)[x], acc);
+        }
+        out[x] = acc;
+        x += 1;
+    }
+}
+
+dispatch_kernel!(
+    /// `out[x] = sum_i w_i * src.row(r_i)[x]`: a weighted sum of rows.
+    pub fn accumulate_rows => accumulate_rows_generic(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32])
+);
+
+fn check_kernel(k: &[f32], what: &str) -> Result<()> {
+    if k.is_empty() || k.len() % 2 == 0 {
+        return Err(ImageError::InvalidParameter(format!(
+            "{what} kernel has {} taps: a centred kernel needs an odd number",
+            k.len()
+        )));
+    }
+    if k.iter().any(|v| !v.is_finite()) {
+        return Err(ImageError::InvalidParameter(format!("{what} kernel has a non-finite tap")));
+    }
+    Ok(())
+}
+
+/// Fills `p` with `row` padded by `hw` values on each side according to `border`.
+fn pad_row(row: &[f32], hw: usize, border: Border, p: &mut Vec<f32>) {
+    let w = row.len();
+    p.clear();
+    p.resize(w + 2 * hw, 0.0);
+    p[hw..hw + w].copy_from_slice(row);
+    if border == Border::Clamp && w > 0 {
+        let (first, last) = (row[0], row[w - 1]);
+        p[..hw].fill(first);
+        p[hw + w..].fill(last);
+    }
+}
+
+/// Row list for output row `y` of a vertical pass with kernel `k` (centred).
+fn vertical_taps(y: usize, h: usize, k: &[f32], border: Border, rows: &mut Vec<(usize, f32)>) {
+    let hw = (k.len() - 1) / 2;
+    rows.clear();
+    for (t, &kt) in k.iter().enumerate() {
+        let yy = y as isize + t as isize - hw as isize;
+        let r = match border {
+            Border::Zero if yy < 0 || yy >= h as isize => continue,
+            Border::Zero => yy as usize,
+            Border::Clamp => yy.clamp(0, h as isize - 1) as usize,
+        };
+        rows.push((r, kt));
+    }
+}
+
+/// Correlates every row of `src` with `kx` (centred), `dst` resized to `src`.
+pub fn filter_rows(backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>, kx: &[f32], border: Border, scratch: &mut FilterScratch) -> Result<()> {
+    check_kernel(kx, "horizontal")?;
+    let (w, h) = src.size();
+    dst.resize(w, h);
+    let hwx = (kx.len() - 1) / 2;
+    for y in 0..h {
+        pad_row(src.row(y), hwx, border, &mut scratch.padded);
+        correlate_padded(backend, &scratch.padded, kx, dst.row_mut(y));
+    }
+    Ok(())
+}
+
+/// Correlates every column of `src` with `ky` (centred), `dst` resized to `src`.
+pub fn filter_cols(backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>, ky: &[f32], border: Border, scratch: &mut FilterScratch) -> Result<()> {
+    check_kernel(ky, "vertical")?;
+    let (w, h) = src.size();
+    dst.resize(w, h);
+    for y in 0..h {
+        vertical_taps(y, h, ky, border, &mut scratch.rows);
+        accumulate_rows(backend, src, &scratch.rows, dst.row_mut(y));
+    }
+    Ok(())
+}
+
+/// Separable correlation: rows with `kx`, then columns with `ky`, `dst` resized to `src`.
+pub fn sep_filter(
+    backend: Backend,
+    src: &Plane<f32>,
+    dst: &mut Plane<f32>,
+    kx: &[f32],
+    ky: &[f32],
+    border: Border,
+    scratch: &mut FilterScratch,
+) -> Result<()> {
+    let mut tmp = std::mem::take(&mut scratch.tmp);
+    let r = filter_rows(backend, src, &mut tmp, kx, border, scratch).and_then(|_| filter_cols(backend, &tmp, dst, ky, border, scratch));
+    scratch.tmp = tmp;
+    r
+}
+
+/// Direct 2D correlation (slow reference): `out(x,y) = sum k(i,j) in(x+i-hw, y+j-hh)`.
+/// `k` is row-major `kw` x `kh`, both odd.
+pub fn correlate_2d_direct(src: &Plane<f32>, k: &[f32], kw: usize, kh: usize, border: Border) -> Plane<f32> {
+    let (w, h) = src.size();
+    let (hx, hy) = ((kw as isize - 1) / 2, (kh as isize - 1) / 2);
+    Plane::from_fn(w, h, |x, y| {
+        let mut acc = 0f64;
+        for j in 0..kh as isize {
+            for i in 0..kw as isize {
+                let (xx, yy) = (x as isize + i - hx, y as isize + j - hy);
+                let v = match border {
+                    Border::Zero if xx < 0 || yy < 0 || xx >= w as isize || yy >= h as isize => 0.0,
+                    Border::Zero => src.get(xx as usize, yy as usize),
+                    Border::Clamp => src.get(xx.clamp(0, w as isize - 1) as usize, yy.clamp(0, h as isize - 1) as usize),
+                };
+                acc += k[(j * kw as isize + i) as usize] as f64 * v as f64;
+            }
+        }
+        acc as f32
+    })
+}
+
+/// Separable correlation with a zero border whose result at each pixel is rescaled by
+/// `sum(kernel) / sum(kernel taps inside the image)`, per axis: the kernel is truncated
+/// at the border and renormalized, so a border does not lower the response
+/// (Walther & Koch 2006, `sepConv2PreserveEnergy`).
+///
+/// Built once for a map size; [`PreservingFilter::apply`] allocates nothing.
+#[derive(Debug, Clone)]
+pub struct PreservingFilter {
+    k: Vec<f32>,
+    width: usize,
+    height: usize,
+    fx: Vec<f32>,
+    rows: Vec<Vec<(usize, f32)>>,
+    padded: Vec<f32>,
+    tmp: Plane<f32>,
+}
+
+impl PreservingFilter {
+    /// The same 1D kernel `k` (odd length, positive sum) on both axes of a `width` x `height` map.
+    pub fn new(k: &[f32], width: usize, height: usize) -> Result<Self> {
+        check_kernel(k, "energy-preserving")?;
+        let total: f32 = k.iter().sum();
+        if total <= 0.0 {
+            return Err(ImageError::InvalidParameter("energy-preserving kernel must have a positive sum".into()));
+        }
+        let hw = (k.len() - 1) / 2;
+        let valid_sum = |i: usize, n: usize| -> f32 {
+            k.iter()
+                .enumerate()
+                .filter(|(t, _)| {
+                    let p = i as isize + *t as isize - hw as isize;
+                    p >= 0 && p < n as isize
+                })
+                .map(|(_, &v)| v)
+                .sum()
+        };
+        let fx = (0..width).map(|x| total / valid_sum(x, width)).collect();
+        let rows = (0..height)
+            .map(|y| {
+                let f = total / valid_sum(y, height);
+                let mut r = Vec::new();
+                vertical_taps(y, height, k, Border::Zero, &mut r);
+                r.iter_mut().for_each(|(_, w)| *w *= f);
+                r
+            })
+            .collect();
+        Ok(Self {
+            k: k.to_vec(),
+            width,
+            height,
+            fx,
+            rows,
+            padded: vec![0.0; width + 2 * hw],
+            tmp: Plane::new(width, height),
+        })
+    }
+
+    /// Filters `src` (which must be `width` x `height`) into `dst`.
+    pub fn apply(&mut self, backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>) -> Result<()> {
+        if src.size() != (self.width, self.height) {
+            return Err(ImageError::SizeMismatch {
+                what: "map",
+                got_w: src.width(),
+                got_h: src.height(),
+                want_w: self.width,
+                want_h: self.height,
+            });
+        }
+        let hw = (self.k.len() - 1) / 2;
+        dst.resize(self.width, self.height);
+        for y in 0..self.height {
+            self.padded[hw..hw + self.width].copy_from_slice(src.row(y));
+            let out = self.tmp.row_mut(y);
+            correlate_padded(backend, &self.padded, &self.k, out);
+            for (o, f) in out.iter_mut().zip(&self.fx) {
+                *o *= f;
+            }
+        }
+        for y in 0..self.height {
+            accumulate_rows(backend, &self.tmp, &self.rows[y], dst.row_mut(y));
+        }
+        Ok(())
+    }
+}

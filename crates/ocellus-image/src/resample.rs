@@ -1,0 +1,127 @@
+//! Resampling a plane to another size with precomputed index tables.
+
+use crate::{ImageError, Plane, Result};
+use serde::{Deserialize, Serialize};
+
+/// How samples are taken when changing size.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ResampleMethod {
+    /// Bilinear, pixel centres aligned: destination x samples source
+    /// `(x + 0.5) * src_w / dst_w - 0.5`, clamped to the image (GPU texture rule).
+    Bilinear,
+    /// Nearest neighbour with GNU Octave's `imresize(..., 'nearest')` index rule (integer
+    /// factors by repetition or `ceil(linspace(floor(f/2)+1, n, m))`, otherwise corner-aligned
+    /// `linspace(1, n, m)` rounded half up). Used by the SaliencyToolbox reference.
+    NearestOctave,
+}
+
+/// Per-axis table: destination index -> (i0, i1, weight of i1).
+type AxisTable = Vec<(usize, usize, f32)>;
+
+/// Resamples planes of one size to another; build once, apply per frame without allocation.
+#[derive(Clone, Debug)]
+pub struct Resampler {
+    src: (usize, usize),
+    dst: (usize, usize),
+    xs: AxisTable,
+    ys: AxisTable,
+}
+
+fn bilinear_axis(n_in: usize, n_out: usize) -> AxisTable {
+    (0..n_out)
+        .map(|o| {
+            let u = ((o as f64 + 0.5) * n_in as f64 / n_out as f64 - 0.5).clamp(0.0, (n_in - 1) as f64);
+            let i0 = u.floor() as usize;
+            let i1 = (i0 + 1).min(n_in - 1);
+            (i0, i1, (u - i0 as f64) as f32)
+        })
+        .collect()
+}
+
+/// Octave's integer-factor test: 1 for an integer factor, -1 for 1/integer, 0 otherwise.
+fn octave_int_kind(n_in: usize, n_out: usize) -> i32 {
+    if n_out % n_in == 0 {
+        1
+    } else if n_in % n_out == 0 {
+        -1
+    } else {
+        0
+    }
+}
+
+fn nearest_octave_axis(n_in: usize, n_out: usize, both_integer: bool) -> AxisTable {
+    let last = n_out.saturating_sub(1).max(1) as u64;
+    let idx: Vec<usize> = match (both_integer, octave_int_kind(n_in, n_out)) {
+        (true, 1) => (0..n_out).map(|o| o / (n_out / n_in)).collect(),
+        (true, -1) => {
+            // ceil(linspace(a, n_in, n_out)) with a = floor(factor / 2) + 1, exactly.
+            let a = (n_in / n_out / 2 + 1) as u64;
+            (0..n_out as u64)
+                .map(|k| {
+                    let v = if n_out == 1 { n_in as u64 } else { (a * last + (n_in as u64 - a) * k).div_ceil(last) };
+                    v as usize - 1
+                })
+                .collect()
+        }
+        _ => (0..n_out as u64)
+            .map(|k| {
+                // round-half-up of linspace(1, n_in, n_out), exactly.
+                let v = if n_out == 1 { n_in as u64 } else { (2 * last + 2 * (n_in as u64 - 1) * k + last) / (2 * last) };
+                v as usize - 1
+            })
+            .collect(),
+    };
+    idx.into_iter().map(|i| (i, i, 0.0)).collect()
+}
+
+impl Resampler {
+    /// Tables for resampling `src` (w, h) to `dst` (w, h) with `method`.
+    pub fn new(method: ResampleMethod, src: (usize, usize), dst: (usize, usize)) -> Result<Self> {
+        if src.0 == 0 || src.1 == 0 {
+            return Err(ImageError::Empty { width: src.0, height: src.1 });
+        }
+        if dst.0 == 0 || dst.1 == 0 {
+            return Err(ImageError::Empty { width: dst.0, height: dst.1 });
+        }
+        let (xs, ys) = match method {
+            ResampleMethod::Bilinear => (bilinear_axis(src.0, dst.0), bilinear_axis(src.1, dst.1)),
+            ResampleMethod::NearestOctave => {
+                let both = octave_int_kind(src.0, dst.0) != 0 && octave_int_kind(src.1, dst.1) != 0;
+                (nearest_octave_axis(src.0, dst.0, both), nearest_octave_axis(src.1, dst.1, both))
+            }
+        };
+        Ok(Self { src, dst, xs, ys })
+    }
+
+    /// Destination size (w, h).
+    pub fn dst_size(&self) -> (usize, usize) {
+        self.dst
+    }
+
+    /// Resamples `src` into `dst` (resized to the destination size).
+    pub fn apply(&self, src: &Plane<f32>, dst: &mut Plane<f32>) -> Result<()> {
+        if src.size() != self.src {
+            return Err(ImageError::SizeMismatch { what: "resampler input", got_w: src.width(), got_h: src.height(), want_w: self.src.0, want_h: self.src.1 });
+        }
+        dst.resize(self.dst.0, self.dst.1);
+        for (y, &(y0, y1, fy)) in self.ys.iter().enumerate() {
+            let (r0, r1) = (src.row(y0), src.row(y1));
+            let out = dst.row_mut(y);
+            for (o, &(x0, x1, fx)) in out.iter_mut().zip(&self.xs) {
+                let top = r0[x0] + fx * (r0[x1] - r0[x0]);
+                let bot = r1[x0] + fx * (r1[x1] - r1[x0]);
+                *o = top + fy * (bot - top);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Allocating convenience: resample `src` to `w` x `h`.
+pub fn resize(src: &Plane<f32>, w: usize, h: usize, method: ResampleMethod) -> Result<Plane<f32>> {
+    let r = Resampler::new(method, src.size(), (w, h))?;
+    let mut dst = Plane::default();
+    r.apply(src, &mut dst)?;
+    Ok(dst)
+}

@@ -1,0 +1,122 @@
+//! Run-time choice between the portable and the AVX2 + FMA builds of the hot kernels.
+//!
+//! Each hot kernel is written once as an `#[inline(always)]` function generic over [`Madd`]
+//! (how `a * b + c` is computed) and instantiated twice: a portable build (separate multiply
+//! and add) and a build inside `#[target_feature(enable = "avx2,fma")]` that uses fused
+//! multiply-adds and lets the compiler vectorize with 256-bit registers. The two agree to
+//! within float rounding (tests check 1e-5).
+
+use serde::{Deserialize, Serialize};
+
+/// Which build of the hot kernels to run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Backend {
+    /// The fastest one this CPU supports (decided once per call of [`Backend::resolve`]).
+    #[default]
+    Auto,
+    /// Portable code, no CPU feature assumed.
+    Scalar,
+    /// AVX2 + FMA (x86-64 only).
+    Avx2,
+}
+
+impl Backend {
+    /// The fastest backend available on this CPU.
+    pub fn detect() -> Backend {
+        if avx2_available() {
+            Backend::Avx2
+        } else {
+            Backend::Scalar
+        }
+    }
+
+    /// Turns `Auto` into a concrete backend; an unavailable `Avx2` falls back to `Scalar`.
+    pub fn resolve(self) -> Backend {
+        match self {
+            Backend::Auto => Backend::detect(),
+            Backend::Avx2 if !avx2_available() => Backend::Scalar,
+            b => b,
+        }
+    }
+
+    /// Every concrete backend this CPU can run (for conformance tests).
+    pub fn available() -> Vec<Backend> {
+        let mut v = vec![Backend::Scalar];
+        if avx2_available() {
+            v.push(Backend::Avx2);
+        }
+        v
+    }
+
+    /// Short name, for reports.
+    pub fn name(self) -> &'static str {
+        match self.resolve() {
+            Backend::Avx2 => "avx2+fma",
+            _ => "scalar",
+        }
+    }
+}
+
+/// True when the CPU has AVX2 and FMA (std caches the detection).
+#[inline]
+pub fn avx2_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// How a kernel computes `a * b + c`.
+pub trait Madd {
+    /// `a * b + c`, fused or not.
+    fn madd(a: f32, b: f32, c: f32) -> f32;
+}
+
+/// Separate multiply and add: portable, no FMA instruction needed.
+pub struct Plain;
+impl Madd for Plain {
+    #[inline(always)]
+    fn madd(a: f32, b: f32, c: f32) -> f32 {
+        a * b + c
+    }
+}
+
+/// Fused multiply-add; only used inside functions compiled with the `fma` feature.
+pub struct Fused;
+impl Madd for Fused {
+    #[inline(always)]
+    fn madd(a: f32, b: f32, c: f32) -> f32 {
+        a.mul_add(b, c)
+    }
+}
+
+/// Defines `$name(backend, args..)` that runs `$generic::<Plain>` or, on AVX2 + FMA
+/// CPUs, `$generic::<Fused>` compiled with those features enabled.
+#[macro_export]
+macro_rules! dispatch_kernel {
+    ($(#[$m:meta])* $vis:vis fn $name:ident => $generic:ident ( $($arg:ident : $ty:ty),* $(,)? )) => {
+        $(#[$m])*
+        #[inline]
+        $vis fn $name(backend: $crate::Backend, $($arg: $ty),*) {
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx2,fma")]
+                unsafe fn avx2($($arg: $ty),*) {
+                    $generic::<$crate::simd::Fused>($($arg),*)
+                }
+                if backend.resolve() == $crate::Backend::Avx2 {
+                    // SAFETY: resolve() returns Avx2 only when the CPU supports AVX2 and FMA.
+                    unsafe { avx2($($arg),*) };
+                    return;
+                }
+            }
+            let _ = backend;
+            $generic::<$crate::simd::Plain>($($arg),*)
+        }
+    };
+}
