@@ -67,7 +67,13 @@ fn split_rows<P: Copy + Default>(src: &Plane<P>, to: impl Fn(P) -> [f32; 3], out
 }
 
 #[inline(always)]
-fn opponent_rows<P: Copy + Default>(src: &Plane<P>, to: impl Fn(P) -> [f32; 3], w: [f32; 3], thr: f32, out: [&mut Plane<f32>; 3]) {
+fn opponent_rows<P: Copy + Default>(
+    src: &Plane<P>,
+    to: impl Fn(P) -> [f32; 3],
+    w: [f32; 3],
+    thr: f32,
+    out: [&mut Plane<f32>; 3],
+) {
     split_rows(
         src,
         |p| {
@@ -117,7 +123,13 @@ pub fn split_rgb(backend: Backend, img: &RgbImage, mut out: [&mut Plane<f32>; 3]
 }
 
 /// Intensity, RG and BY planes straight from an RGB image.
-pub fn opponent_planes(backend: Backend, img: &RgbImage, weights: [f32; 3], threshold: f32, mut out: [&mut Plane<f32>; 3]) {
+pub fn opponent_planes(
+    backend: Backend,
+    img: &RgbImage,
+    weights: [f32; 3],
+    threshold: f32,
+    mut out: [&mut Plane<f32>; 3],
+) {
     let (w, h) = img.size();
     resize3(&mut out, w, h);
     match img {

@@ -208,7 +208,10 @@ impl Default for SaliencyConfig {
 }
 
 fn standard_channels() -> Vec<ChannelConfig> {
-    [ChannelKind::Intensity, ChannelKind::Color, ChannelKind::Orientation].into_iter().map(|kind| ChannelConfig { kind, weight: 1.0 }).collect()
+    [ChannelKind::Intensity, ChannelKind::Color, ChannelKind::Orientation]
+        .into_iter()
+        .map(|kind| ChannelConfig { kind, weight: 1.0 })
+        .collect()
 }
 
 impl SaliencyConfig {
@@ -223,7 +226,14 @@ impl SaliencyConfig {
             opponency_at: OpponencyStage::EachLevel,
             intensity: IntensityWeights::Mean,
             color_threshold: 0.1,
-            gabor: GaborConfig { size: 19, wavelength_px: 7.0, sigma_px: 7.0 / 3.0, gamma: 1.0, angles_deg: vec![0.0, 45.0, 90.0, 135.0], border: GaborBorder::Clamp },
+            gabor: GaborConfig {
+                size: 19,
+                wavelength_px: 7.0,
+                sigma_px: 7.0 / 3.0,
+                gamma: 1.0,
+                angles_deg: vec![0.0, 45.0, 90.0, 135.0],
+                border: GaborBorder::Clamp,
+            },
             center_levels: vec![2, 3, 4],
             deltas: vec![3, 4],
             map_level: 4,
@@ -258,7 +268,7 @@ impl SaliencyConfig {
         c.gabor.size = 9;
         c.gabor.sigma_px = 2.3333;
         c.gabor.border = GaborBorder::StbCompat;
-        c.across_scale = ResampleMethod::NearestOctave;
+        c.across_scale = ResampleMethod::Nearest;
         c.border_ramp_frac = 1.0 / 20.0;
         if let Normalization::Iterative { global_inhibition, .. } = &mut c.normalization {
             *global_inhibition = GlobalInhibition::RelativeToMax(0.02);
@@ -332,12 +342,23 @@ impl SaliencyConfig {
                 return bad(format!("final_range = {r}: must be positive"));
             }
         }
-        if let Normalization::Iterative { iterations, excitation_sigma_frac, inhibition_sigma_frac, c_excitation, c_inhibition, global_inhibition } = &self.normalization {
+        if let Normalization::Iterative {
+            iterations,
+            excitation_sigma_frac,
+            inhibition_sigma_frac,
+            c_excitation,
+            c_inhibition,
+            global_inhibition,
+        } = &self.normalization
+        {
             let gi = match global_inhibition {
                 GlobalInhibition::Constant(v) | GlobalInhibition::RelativeToMax(v) => *v,
             };
             let vals = [*excitation_sigma_frac, *inhibition_sigma_frac, *c_excitation, *c_inhibition, gi];
-            if vals.iter().any(|v| !v.is_finite() || *v < 0.0) || *excitation_sigma_frac <= 0.0 || *inhibition_sigma_frac <= 0.0 {
+            if vals.iter().any(|v| !v.is_finite() || *v < 0.0)
+                || *excitation_sigma_frac <= 0.0
+                || *inhibition_sigma_frac <= 0.0
+            {
                 return bad("normalization sigmas must be positive and coefficients non-negative".into());
             }
             if *iterations > 100 {

@@ -124,7 +124,8 @@ impl GaborBank {
                 soo += (o - mo) * (o - mo);
             }
             let inv = |s: f64| if s > 0.0 { (1.0 / s.sqrt()) as f32 } else { 0.0 };
-            let mirror_of = dirs.iter().position(|&(pc, ps)| (pc + c).abs() < 1e-9 && (ps - s).abs() < 1e-9 && c != 0.0);
+            let mirror_of =
+                dirs.iter().position(|&(pc, ps)| (pc + c).abs() < 1e-9 && (ps - s).abs() < 1e-9 && c != 0.0);
             dirs.push((c, s));
             angles.push(AngleFilters {
                 hr: hr.iter().map(|&v| v as f32).collect(),
@@ -213,18 +214,21 @@ impl GaborBank {
             let f = &self.angles[a];
             let p = &self.parts[a];
             let o = &mut out[a];
-            o.resize(src.width(), src.height());
-            for y in 0..src.height() {
+            let (w, h) = src.size();
+            o.resize(w, h);
+            let h2 = self.cfg.size / 2;
+            let stb = self.cfg.border == GaborBorder::StbCompat && h2 > 0 && h2 <= h;
+            for y in 0..h {
                 let (a0, a1, a2, a3, bx) = (p[0].row(y), p[1].row(y), p[2].row(y), p[3].row(y), self.box_.row(y));
                 let orow = o.row_mut(y);
-                for x in 0..orow.len() {
+                let (fe, fo) = if stb { stb_row_factors(&self.cfg, f, y, h) } else { (1.0, 1.0) };
+                let (x0, x1) = if stb && (fe, fo) != (1.0, 1.0) { (h2, w.saturating_sub(h2).max(h2)) } else { (w, w) };
+                for x in 0..w {
                     let even = (a0[x] - a1[x] - f.mean_even * bx[x]) * f.inv_norm_even;
                     let odd = (a2[x] + a3[x] - f.mean_odd * bx[x]) * f.inv_norm_odd;
-                    orow[x] = even.abs() + odd.abs();
+                    orow[x] =
+                        if x >= x0 && x < x1 { (even * fe).abs() + (odd * fo).abs() } else { even.abs() + odd.abs() };
                 }
-            }
-            if self.cfg.border == GaborBorder::StbCompat {
-                stb_zero_rows(o, self.cfg.size / 2);
             }
         }
         Ok(())
@@ -242,13 +246,30 @@ fn zero_like(p: &mut Plane<f32>, like: &Plane<f32>) {
     p.fill(0.0);
 }
 
-/// Zeroes the top and bottom `h2` rows in columns `h2..w-h2` (SaliencyToolbox quirk).
-fn stb_zero_rows(o: &mut Plane<f32>, h2: usize) {
-    let (w, h) = o.size();
-    if h2 == 0 || h2 > h || w <= 2 * h2 {
-        return;
+/// SaliencyToolbox's `conv2PreserveEnergy` multiplies the top and bottom `size/2` rows of
+/// the interior columns by `sum(kernel) / (partial row sums)`. For a zero-mean Gabor that
+/// is a ratio of rounding residues: about 1e-15 (so 0) for every default kernel except the
+/// odd kernel whose rows sum to zero exactly (its 90 degree angle, our 0 degrees), where
+/// the ratios are O(1). These are those ratios for the default 9x9 kernel (sigma 2.3333,
+/// period 7), evaluated with GNU Octave 7.3: rows 1..4 from the top, and rows h-3..h.
+const STB_ODD_TOP: [f32; 4] = [-1.708_333_3, -2.5625, 5.125, 3.416_666_7];
+const STB_ODD_BOTTOM: [f32; 4] = [3.416_666_7, 5.125, 1.281_25, 2.05];
+
+/// (even, odd) factors of row `y` of an `h`-row map under the SaliencyToolbox rule.
+fn stb_row_factors(cfg: &GaborConfig, f: &AngleFilters, y: usize, h: usize) -> (f32, f32) {
+    let h2 = cfg.size / 2;
+    let known = cfg.size == 9 && (cfg.sigma_px - 2.3333).abs() < 1e-6 && (cfg.wavelength_px - 7.0).abs() < 1e-6;
+    // The odd kernel of an angle with sin = 0 has rows that sum to exactly zero.
+    let odd_rows_vanish = f.vi.is_none() && f.hi.is_some();
+    let (mut fe, mut fo) = (1.0f32, 1.0f32);
+    if y < h2 {
+        fe = 0.0;
+        fo = if known && odd_rows_vanish { STB_ODD_TOP[y] } else { 0.0 };
     }
-    for y in (0..h2).chain(h - h2..h) {
-        o.row_mut(y)[h2..w - h2].fill(0.0);
+    if y + h2 >= h {
+        let k = y + h2 - h; // 0 for row h - h2
+        fe = 0.0;
+        fo *= if known && odd_rows_vanish && h2 == 4 { STB_ODD_BOTTOM[k] } else { 0.0 };
     }
+    (fe, fo)
 }

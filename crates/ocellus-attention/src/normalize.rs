@@ -53,15 +53,30 @@ impl Normalizer {
     /// Builds N(.) for `width` x `height` maps.
     pub fn new(kind: &Normalization, width: usize, height: usize) -> Result<Self> {
         let (mut excitation, mut inhibition) = (None, None);
-        if let Normalization::Iterative { excitation_sigma_frac, inhibition_sigma_frac, c_excitation, c_inhibition, .. } = kind {
+        if let Normalization::Iterative {
+            excitation_sigma_frac,
+            inhibition_sigma_frac,
+            c_excitation,
+            c_inhibition,
+            ..
+        } = kind
+        {
             let sz = width.max(height) as f32;
             let max_hw = (width.min(height) / 2).saturating_sub(1);
             let (es, is) = (sz * excitation_sigma_frac, sz * inhibition_sigma_frac);
             let root = (2.0 * std::f32::consts::PI).sqrt();
-            excitation = Some(PreservingFilter::new(&gaussian_kernel(c_excitation / (es * root), es, max_hw), width, height)?);
-            inhibition = Some(PreservingFilter::new(&gaussian_kernel(c_inhibition / (is * root), is, max_hw), width, height)?);
+            excitation =
+                Some(PreservingFilter::new(&gaussian_kernel(c_excitation / (es * root), es, max_hw), width, height)?);
+            inhibition =
+                Some(PreservingFilter::new(&gaussian_kernel(c_inhibition / (is * root), is, max_hw), width, height)?);
         }
-        Ok(Self { kind: kind.clone(), excitation, inhibition, excit: Plane::new(width, height), inhib: Plane::new(width, height) })
+        Ok(Self {
+            kind: kind.clone(),
+            excitation,
+            inhibition,
+            excit: Plane::new(width, height),
+            inhib: Plane::new(width, height),
+        })
     }
 
     /// Applies N(.) in place: clamp at 0, scale to `[0, range]` when `range` is given, then
@@ -115,7 +130,12 @@ fn local_max(map: &mut Plane<f32>, range: Option<f32>) {
     for y in 1..h.saturating_sub(1) {
         for x in 1..w.saturating_sub(1) {
             let v = map.get(x, y);
-            if v >= thresh && v >= map.get(x - 1, y) && v >= map.get(x + 1, y) && v >= map.get(x, y - 1) && v >= map.get(x, y + 1) {
+            if v >= thresh
+                && v >= map.get(x - 1, y)
+                && v >= map.get(x + 1, y)
+                && v >= map.get(x, y - 1)
+                && v >= map.get(x, y + 1)
+            {
                 n += 1;
                 sum += v as f64;
             }

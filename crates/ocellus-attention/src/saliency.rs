@@ -172,7 +172,11 @@ impl SaliencyEngine {
         let map_size = sizes[cfg.map_level];
         let mut resamplers = Vec::with_capacity(n);
         for (l, &s) in sizes.iter().enumerate() {
-            resamplers.push(if used_levels.contains(&l) { Some(Resampler::new(cfg.across_scale, s, map_size)?) } else { None });
+            resamplers.push(if used_levels.contains(&l) {
+                Some(Resampler::new(cfg.across_scale, s, map_size)?)
+            } else {
+                None
+            });
         }
         let gabor = has(&ChannelKind::Orientation).then(|| GaborBank::new(&cfg.gabor));
         let n_angles = cfg.gabor.angles_deg.len();
@@ -181,7 +185,12 @@ impl SaliencyEngine {
             .iter()
             .enumerate()
             .flat_map(|(_, p)| (0..subs.len()).map(move |s| (s, *p)))
-            .map(|(s, p)| FeatureMap { subfeature: s, center: p.center, surround: p.surround, map: Plane::new(map_size.0, map_size.1) })
+            .map(|(s, p)| FeatureMap {
+                subfeature: s,
+                center: p.center,
+                surround: p.surround,
+                map: Plane::new(map_size.0, map_size.1),
+            })
             .collect::<Vec<_>>();
         // Order feature maps by sub-feature, then pair, for readable listings.
         let mut features = features;
@@ -246,7 +255,9 @@ impl SaliencyEngine {
             None => None,
             Some(p) => {
                 if p.is_empty() || !p.all_finite() || p.min_max().0 < 0.0 {
-                    return Err(AttentionError::InvalidInput("spatial prior must be non-empty, finite and non-negative".into()));
+                    return Err(AttentionError::InvalidInput(
+                        "spatial prior must be non-empty, finite and non-negative".into(),
+                    ));
                 }
                 let (w, h) = self.map_size();
                 let mut out = Plane::default();
@@ -270,11 +281,19 @@ impl SaliencyEngine {
             return Err(AttentionError::FrameSize { width: w, height: h, want_w: self.width, want_h: self.height });
         }
         if external.len() != self.n_external {
-            return Err(AttentionError::InvalidInput(format!("{} external maps given, the configuration has {} external channels", external.len(), self.n_external)));
+            return Err(AttentionError::InvalidInput(format!(
+                "{} external maps given, the configuration has {} external channels",
+                external.len(),
+                self.n_external
+            )));
         }
         for m in external {
             if m.is_empty() || !m.all_finite() {
-                return Err(AttentionError::InvalidInput(format!("external map of {}x{} is empty or has non-finite values", m.width(), m.height())));
+                return Err(AttentionError::InvalidInput(format!(
+                    "external map of {}x{} is empty or has non-finite values",
+                    m.width(),
+                    m.height()
+                )));
             }
         }
         let t0 = Instant::now();
@@ -287,7 +306,14 @@ impl SaliencyEngine {
         self.center_surround();
         let t4 = Instant::now();
         let (norm, comb) = self.normalize_and_combine()?;
-        self.timings = StageTimings { pyramid: t1 - t0, orientation: t2 - t1, rescale: t3 - t2, center_surround: t4 - t3, normalization: norm, combination: comb };
+        self.timings = StageTimings {
+            pyramid: t1 - t0,
+            orientation: t2 - t1,
+            rescale: t3 - t2,
+            center_surround: t4 - t3,
+            normalization: norm,
+            combination: comb,
+        };
         Ok(&self.saliency)
     }
 
@@ -295,7 +321,14 @@ impl SaliencyEngine {
         self.sizes.len() - 1
     }
 
-    fn pyramid_up(backend: Backend, pyr: &mut [Plane<f32>], from: usize, to: usize, k: &ocellus_image::pyramid::PyramidKernel, s: &mut PyrScratch) -> Result<()> {
+    fn pyramid_up(
+        backend: Backend,
+        pyr: &mut [Plane<f32>],
+        from: usize,
+        to: usize,
+        k: &ocellus_image::pyramid::PyramidKernel,
+        s: &mut PyrScratch,
+    ) -> Result<()> {
         for l in from..to {
             let (lo, hi) = pyr.split_at_mut(l + 1);
             pyr_down(backend, &lo[l], &mut hi[0], k, s)?;
@@ -329,7 +362,12 @@ impl SaliencyEngine {
                     }
                     for &l in &self.used_levels {
                         let [i, rg, by] = &mut self.opp;
-                        opponent_from_planes([&self.rgb[0][l], &self.rgb[1][l], &self.rgb[2][l]], weights, cfg.color_threshold, [&mut i[l], &mut rg[l], &mut by[l]]);
+                        opponent_from_planes(
+                            [&self.rgb[0][l], &self.rgb[1][l], &self.rgb[2][l]],
+                            weights,
+                            cfg.color_threshold,
+                            [&mut i[l], &mut rg[l], &mut by[l]],
+                        );
                     }
                 }
             }
@@ -345,7 +383,9 @@ impl SaliencyEngine {
                 Some(r) if r.dst_size() == target && self.external[k][base].size() == target => r,
                 _ => {
                     self.external_resamplers[k] = Some(Resampler::new(ResampleMethod::Bilinear, m.size(), target)?);
-                    self.external_resamplers[k].as_ref().ok_or_else(|| AttentionError::InvalidInput("resampler".into()))?
+                    self.external_resamplers[k]
+                        .as_ref()
+                        .ok_or_else(|| AttentionError::InvalidInput("resampler".into()))?
                 }
             };
             if rs.apply(m, &mut self.external[k][base]).is_err() {
@@ -509,7 +549,8 @@ impl SaliencyEngine {
         let up = match &self.upsampler {
             Some(u) => u,
             None => {
-                self.upsampler = Some(Resampler::new(ResampleMethod::Bilinear, self.map_size(), (self.width, self.height))?);
+                self.upsampler =
+                    Some(Resampler::new(ResampleMethod::Bilinear, self.map_size(), (self.width, self.height))?);
                 self.upsampler.as_ref().ok_or_else(|| AttentionError::InvalidInput("upsampler".into()))?
             }
         };

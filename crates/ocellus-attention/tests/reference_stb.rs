@@ -38,7 +38,10 @@ fn compare(name: &str) -> (f64, [f64; 3]) {
         let theirs: Vec<f64> = (0..1200).map(|i| ref_cm.data[i * 3 + k]).collect();
         ccs[k] = pearson(&ours, &theirs);
     }
-    println!("{name}: saliency CC {cc_sal:.4}; conspicuity CC colour {:.4} intensity {:.4} orientation {:.4}", ccs[0], ccs[1], ccs[2]);
+    println!(
+        "{name}: saliency CC {cc_sal:.4}; conspicuity CC colour {:.4} intensity {:.4} orientation {:.4}",
+        ccs[0], ccs[1], ccs[2]
+    );
     (cc_sal, ccs)
 }
 

@@ -49,7 +49,12 @@ pub fn from_dynamic(img: &DynamicImage) -> Result<RgbImage> {
     }
     let high_precision = matches!(
         img,
-        DynamicImage::ImageLuma16(_) | DynamicImage::ImageLumaA16(_) | DynamicImage::ImageRgb16(_) | DynamicImage::ImageRgba16(_) | DynamicImage::ImageRgb32F(_) | DynamicImage::ImageRgba32F(_)
+        DynamicImage::ImageLuma16(_)
+            | DynamicImage::ImageLumaA16(_)
+            | DynamicImage::ImageRgb16(_)
+            | DynamicImage::ImageRgba16(_)
+            | DynamicImage::ImageRgb32F(_)
+            | DynamicImage::ImageRgba32F(_)
     );
     if high_precision {
         let buf = img.to_rgb32f();
@@ -80,5 +85,7 @@ pub fn to_image_gray8(p: &Plane<f32>, lo: f32, hi: f32) -> image::GrayImage {
 
 /// A grey `image` buffer as a float plane in [0, 1].
 pub fn from_image_gray8(img: &image::GrayImage) -> Plane<f32> {
-    Plane::from_fn(img.width() as usize, img.height() as usize, |x, y| img.get_pixel(x as u32, y as u32).0[0] as f32 / 255.0)
+    Plane::from_fn(img.width() as usize, img.height() as usize, |x, y| {
+        img.get_pixel(x as u32, y as u32).0[0] as f32 / 255.0
+    })
 }

@@ -154,7 +154,14 @@ fn vertical_taps(y: usize, h: usize, k: &[f32], border: Border, rows: &mut Vec<(
 }
 
 /// Correlates every row of `src` with `kx` (centred), `dst` resized to `src`.
-pub fn filter_rows(backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>, kx: &[f32], border: Border, scratch: &mut FilterScratch) -> Result<()> {
+pub fn filter_rows(
+    backend: Backend,
+    src: &Plane<f32>,
+    dst: &mut Plane<f32>,
+    kx: &[f32],
+    border: Border,
+    scratch: &mut FilterScratch,
+) -> Result<()> {
     check_kernel(kx, "horizontal")?;
     let (w, h) = src.size();
     dst.resize(w, h);
@@ -167,7 +174,14 @@ pub fn filter_rows(backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>, kx:
 }
 
 /// Correlates every column of `src` with `ky` (centred), `dst` resized to `src`.
-pub fn filter_cols(backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>, ky: &[f32], border: Border, scratch: &mut FilterScratch) -> Result<()> {
+pub fn filter_cols(
+    backend: Backend,
+    src: &Plane<f32>,
+    dst: &mut Plane<f32>,
+    ky: &[f32],
+    border: Border,
+    scratch: &mut FilterScratch,
+) -> Result<()> {
     check_kernel(ky, "vertical")?;
     let (w, h) = src.size();
     dst.resize(w, h);
@@ -189,7 +203,8 @@ pub fn sep_filter(
     scratch: &mut FilterScratch,
 ) -> Result<()> {
     let mut tmp = std::mem::take(&mut scratch.tmp);
-    let r = filter_rows(backend, src, &mut tmp, kx, border, scratch).and_then(|_| filter_cols(backend, &tmp, dst, ky, border, scratch));
+    let r = filter_rows(backend, src, &mut tmp, kx, border, scratch)
+        .and_then(|_| filter_cols(backend, &tmp, dst, ky, border, scratch));
     scratch.tmp = tmp;
     r
 }
@@ -207,7 +222,9 @@ pub fn correlate_2d_direct(src: &Plane<f32>, k: &[f32], kw: usize, kh: usize, bo
                 let v = match border {
                     Border::Zero if xx < 0 || yy < 0 || xx >= w as isize || yy >= h as isize => 0.0,
                     Border::Zero => src.get(xx as usize, yy as usize),
-                    Border::Clamp => src.get(xx.clamp(0, w as isize - 1) as usize, yy.clamp(0, h as isize - 1) as usize),
+                    Border::Clamp => {
+                        src.get(xx.clamp(0, w as isize - 1) as usize, yy.clamp(0, h as isize - 1) as usize)
+                    }
                 };
                 acc += k[(j * kw as isize + i) as usize] as f64 * v as f64;
             }

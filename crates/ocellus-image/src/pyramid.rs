@@ -45,7 +45,11 @@ impl PyramidKernel {
     /// Checks the kernel: non-empty, finite, non-negative, origin inside.
     pub fn validate(&self) -> Result<()> {
         let s: f32 = self.taps.iter().sum();
-        if self.taps.is_empty() || self.origin >= self.taps.len() || self.taps.iter().any(|t| !t.is_finite() || *t < 0.0) || s <= 0.0 {
+        if self.taps.is_empty()
+            || self.origin >= self.taps.len()
+            || self.taps.iter().any(|t| !t.is_finite() || *t < 0.0)
+            || s <= 0.0
+        {
             return Err(ImageError::InvalidParameter(format!(
                 "pyramid kernel {:?} with origin {} must be non-empty, non-negative, finite, with the origin inside",
                 self.taps, self.origin
@@ -141,10 +145,18 @@ dispatch_kernel!(fn decimate_interior => decimate_interior_generic(
 /// One pyramid level: `dst` becomes the low-passed, decimated `src` (`floor(w/2)` x `floor(h/2)`).
 ///
 /// Errors if `src` is smaller than 2x2 (no next level exists).
-pub fn pyr_down(backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>, kernel: &PyramidKernel, s: &mut PyrScratch) -> Result<()> {
+pub fn pyr_down(
+    backend: Backend,
+    src: &Plane<f32>,
+    dst: &mut Plane<f32>,
+    kernel: &PyramidKernel,
+    s: &mut PyrScratch,
+) -> Result<()> {
     let (w, h) = src.size();
     if w < 2 || h < 2 {
-        return Err(ImageError::InvalidParameter(format!("cannot decimate a {w}x{h} image: both sides must be at least 2")));
+        return Err(ImageError::InvalidParameter(format!(
+            "cannot decimate a {w}x{h} image: both sides must be at least 2"
+        )));
     }
     let (ow, oh) = next_size(w, h);
     // Vertical first: full-width rows vectorize without shuffles.

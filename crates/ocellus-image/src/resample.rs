@@ -10,10 +10,10 @@ pub enum ResampleMethod {
     /// Bilinear, pixel centres aligned: destination x samples source
     /// `(x + 0.5) * src_w / dst_w - 0.5`, clamped to the image (GPU texture rule).
     Bilinear,
-    /// Nearest neighbour with GNU Octave's `imresize(..., 'nearest')` index rule (integer
-    /// factors by repetition or `ceil(linspace(floor(f/2)+1, n, m))`, otherwise corner-aligned
-    /// `linspace(1, n, m)` rounded half up). Used by the SaliencyToolbox reference.
-    NearestOctave,
+    /// Nearest neighbour: destination pixel x takes the source pixel that contains its
+    /// centre, `floor((x + 0.5) * src_w / dst_w)` (MATLAB's and GNU Octave 7's
+    /// `imresize(..., 'nearest')`, used by the SaliencyToolbox reference).
+    Nearest,
 }
 
 /// Per-axis table: destination index -> (i0, i1, weight of i1).
@@ -39,40 +39,14 @@ fn bilinear_axis(n_in: usize, n_out: usize) -> AxisTable {
         .collect()
 }
 
-/// Octave's integer-factor test: 1 for an integer factor, -1 for 1/integer, 0 otherwise.
-fn octave_int_kind(n_in: usize, n_out: usize) -> i32 {
-    if n_out % n_in == 0 {
-        1
-    } else if n_in % n_out == 0 {
-        -1
-    } else {
-        0
-    }
-}
-
-fn nearest_octave_axis(n_in: usize, n_out: usize, both_integer: bool) -> AxisTable {
-    let last = n_out.saturating_sub(1).max(1) as u64;
-    let idx: Vec<usize> = match (both_integer, octave_int_kind(n_in, n_out)) {
-        (true, 1) => (0..n_out).map(|o| o / (n_out / n_in)).collect(),
-        (true, -1) => {
-            // ceil(linspace(a, n_in, n_out)) with a = floor(factor / 2) + 1, exactly.
-            let a = (n_in / n_out / 2 + 1) as u64;
-            (0..n_out as u64)
-                .map(|k| {
-                    let v = if n_out == 1 { n_in as u64 } else { (a * last + (n_in as u64 - a) * k).div_ceil(last) };
-                    v as usize - 1
-                })
-                .collect()
-        }
-        _ => (0..n_out as u64)
-            .map(|k| {
-                // round-half-up of linspace(1, n_in, n_out), exactly.
-                let v = if n_out == 1 { n_in as u64 } else { (2 * last + 2 * (n_in as u64 - 1) * k + last) / (2 * last) };
-                v as usize - 1
-            })
-            .collect(),
-    };
-    idx.into_iter().map(|i| (i, i, 0.0)).collect()
+fn nearest_axis(n_in: usize, n_out: usize) -> AxisTable {
+    (0..n_out)
+        .map(|o| {
+            // floor((o + 0.5) * n_in / n_out), in exact integer arithmetic.
+            let i = ((2 * o + 1) * n_in / (2 * n_out)).min(n_in - 1);
+            (i, i, 0.0)
+        })
+        .collect()
 }
 
 impl Resampler {
@@ -86,10 +60,7 @@ impl Resampler {
         }
         let (xs, ys) = match method {
             ResampleMethod::Bilinear => (bilinear_axis(src.0, dst.0), bilinear_axis(src.1, dst.1)),
-            ResampleMethod::NearestOctave => {
-                let both = octave_int_kind(src.0, dst.0) != 0 && octave_int_kind(src.1, dst.1) != 0;
-                (nearest_octave_axis(src.0, dst.0, both), nearest_octave_axis(src.1, dst.1, both))
-            }
+            ResampleMethod::Nearest => (nearest_axis(src.0, dst.0), nearest_axis(src.1, dst.1)),
         };
         Ok(Self { src, dst, xs, ys })
     }
@@ -102,7 +73,13 @@ impl Resampler {
     /// Resamples `src` into `dst` (resized to the destination size).
     pub fn apply(&self, src: &Plane<f32>, dst: &mut Plane<f32>) -> Result<()> {
         if src.size() != self.src {
-            return Err(ImageError::SizeMismatch { what: "resampler input", got_w: src.width(), got_h: src.height(), want_w: self.src.0, want_h: self.src.1 });
+            return Err(ImageError::SizeMismatch {
+                what: "resampler input",
+                got_w: src.width(),
+                got_h: src.height(),
+                want_w: self.src.0,
+                want_h: self.src.1,
+            });
         }
         dst.resize(self.dst.0, self.dst.1);
         for (y, &(y0, y1, fy)) in self.ys.iter().enumerate() {

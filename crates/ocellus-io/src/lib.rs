@@ -79,7 +79,9 @@ pub const IMAGE_EXTENSIONS: &[&str] = &["png", "jpg", "jpeg", "pnm", "pbm", "pgm
 
 /// True when the path's extension is one of [`IMAGE_EXTENSIONS`].
 pub fn is_image_path(path: &Path) -> bool {
-    path.extension().and_then(|e| e.to_str()).is_some_and(|e| IMAGE_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| IMAGE_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
 }
 
 /// Reads an image file (format from its content, not its name) as RGB.
@@ -98,7 +100,8 @@ pub fn decode_image(bytes: &[u8], path: &Path) -> Result<RgbImage> {
     if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg | image::ImageFormat::Pnm) {
         return Err(IoError::Unsupported { path: path.into() });
     }
-    let img = image::load_from_memory_with_format(bytes, format).map_err(|e| IoError::Corrupt { path: path.into(), reason: e.to_string() })?;
+    let img = image::load_from_memory_with_format(bytes, format)
+        .map_err(|e| IoError::Corrupt { path: path.into(), reason: e.to_string() })?;
     from_dynamic(&img).map_err(|e| IoError::Invalid { path: path.into(), reason: e.to_string() })
 }
 

@@ -24,7 +24,8 @@ fn header_field<'a>(header: &'a str, key: &str) -> Option<&'a str> {
 
 /// Parses `.npy` bytes; `path` is only used in error messages.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<NpyArray> {
-    let bad = |reason: &str| IoError::Invalid { path: path.into(), reason: format!("not a readable .npy file: {reason}") };
+    let bad =
+        |reason: &str| IoError::Invalid { path: path.into(), reason: format!("not a readable .npy file: {reason}") };
     if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
         return Err(bad("missing magic"));
     }
