@@ -1,0 +1,191 @@
+//! `ocellus bench`: the figures the issues ask for, printed as a table or one JSON object.
+
+use crate::assets;
+use anyhow::{bail, Context, Result};
+use clap::{Args, ValueEnum};
+use ocellus_attention::{SaliencyConfig, SaliencyEngine};
+use ocellus_image::{convert::RgbImage, Backend, Plane};
+use rayon::prelude::*;
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// What to benchmark.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum Target {
+    /// The saliency pipeline (SPEC 1): per-preset ms/frame on one core, fps on all cores.
+    Saliency,
+}
+
+/// Arguments of `ocellus bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// What to measure.
+    pub target: Target,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Frames timed per preset on one thread (the median is reported).
+    #[arg(long, default_value_t = 300)]
+    pub frames: usize,
+    /// Frame width in pixels (the built-in images are resized to it).
+    #[arg(long, default_value_t = 640)]
+    pub width: u32,
+    /// Frame height in pixels.
+    #[arg(long, default_value_t = 480)]
+    pub height: u32,
+    /// Use this image (resized) instead of the built-in ones.
+    #[arg(long)]
+    pub image: Option<PathBuf>,
+    /// Presets to measure (default: ace2009 and stb).
+    #[arg(long, value_delimiter = ',')]
+    pub preset: Vec<String>,
+    /// Kernel build: auto, scalar or avx2.
+    #[arg(long, default_value = "auto")]
+    pub backend: String,
+}
+
+fn frames(a: &BenchArgs) -> Result<Vec<RgbImage>> {
+    let decoded: Vec<image::DynamicImage> = match &a.image {
+        Some(p) => vec![image::open(p).with_context(|| format!("cannot read {}", p.display()))?],
+        None => {
+            assets::IMAGES.iter().map(|(_, b)| image::load_from_memory(b)).collect::<std::result::Result<_, _>>()?
+        }
+    };
+    decoded
+        .iter()
+        .map(|d| {
+            let r = image::imageops::resize(&d.to_rgb8(), a.width, a.height, image::imageops::FilterType::Triangle);
+            let data = r.pixels().map(|p| p.0).collect();
+            Ok(RgbImage::U8(Plane::from_vec(a.width as usize, a.height as usize, data)?))
+        })
+        .collect()
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    if v.is_empty() {
+        0.0
+    } else {
+        v[v.len() / 2]
+    }
+}
+
+/// Peak resident memory of this process in MiB (Linux `VmHWM`), if known.
+pub fn peak_rss_mb() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+fn bench_preset(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize) -> Result<serde_json::Value> {
+    let (w, h) = frames[0].size();
+    let mut e = SaliencyEngine::new(cfg.clone(), w, h)?;
+    for f in frames.iter().cycle().take(20) {
+        e.process(f)?;
+    }
+    let mut total = Vec::with_capacity(n);
+    let mut stages: Vec<Vec<f64>> = vec![Vec::with_capacity(n); 6];
+    for f in frames.iter().cycle().take(n) {
+        let t = Instant::now();
+        e.process(f)?;
+        total.push(t.elapsed().as_secs_f64() * 1e3);
+        for (k, (_, d)) in e.timings().stages().iter().enumerate() {
+            stages[k].push(d.as_secs_f64() * 1e3);
+        }
+    }
+    let ms = median(&mut total);
+    let names = e.timings().stages().map(|s| s.0);
+    let stage_ms: serde_json::Map<String, serde_json::Value> =
+        names.iter().zip(stages.iter_mut()).map(|(n, v)| (n.to_string(), json!(median(v)))).collect();
+
+    // All cores: one engine per worker thread, frames spread over the workers.
+    let threads = rayon::current_num_threads();
+    let n_par = n.max(threads * 50);
+    let t = Instant::now();
+    (0..n_par)
+        .into_par_iter()
+        .map_init(
+            || SaliencyEngine::new(cfg.clone(), w, h),
+            |eng, i| -> Result<()> {
+                match eng {
+                    Ok(e) => {
+                        e.process(&frames[i % frames.len()])?;
+                        Ok(())
+                    }
+                    Err(err) => bail!("{err}"),
+                }
+            },
+        )
+        .collect::<Result<Vec<()>>>()?;
+    let par: Duration = t.elapsed();
+    let fps_all = n_par as f64 / par.as_secs_f64();
+    let fps_1 = 1e3 / ms;
+    Ok(json!({
+        "ms_per_frame_1thread": ms,
+        "fps_1thread": fps_1,
+        "fps_all_threads": fps_all,
+        "speedup_all_threads": fps_all / fps_1,
+        "stage_ms_1thread": stage_ms,
+        "frames_timed": n,
+    }))
+}
+
+/// Runs the subcommand.
+pub fn run(a: BenchArgs) -> Result<()> {
+    let Target::Saliency = a.target;
+    if a.frames == 0 {
+        bail!("--frames must be at least 1");
+    }
+    let backend: Backend = serde_json::from_value(json!(a.backend))
+        .with_context(|| format!("unknown backend '{}' (auto, scalar, avx2)", a.backend))?;
+    let frames = frames(&a)?;
+    let presets = if a.preset.is_empty() {
+        SaliencyConfig::PRESETS.iter().map(|s| s.to_string()).collect()
+    } else {
+        a.preset.clone()
+    };
+    let mut out = serde_json::Map::new();
+    out.insert("frame_width".into(), json!(a.width));
+    out.insert("frame_height".into(), json!(a.height));
+    out.insert("threads".into(), json!(rayon::current_num_threads()));
+    out.insert("backend".into(), json!(backend.name()));
+    for p in &presets {
+        let mut cfg = SaliencyConfig::preset(p)?;
+        cfg.backend = backend;
+        out.insert(p.clone(), bench_preset(&cfg, &frames, a.frames)?);
+    }
+    out.insert("peak_rss_mb".into(), json!(peak_rss_mb()));
+    let v = serde_json::Value::Object(out);
+    if a.json {
+        println!("{v}");
+        return Ok(());
+    }
+    println!(
+        "saliency benchmark: {}x{}, backend {}, {} threads",
+        a.width,
+        a.height,
+        backend.name(),
+        rayon::current_num_threads()
+    );
+    for p in &presets {
+        let r = &v[p];
+        println!(
+            "{p:>8}: {:.3} ms/frame on 1 thread (median of {}), {:.0} fps on all threads ({:.2}x)",
+            r["ms_per_frame_1thread"].as_f64().unwrap_or(0.0),
+            a.frames,
+            r["fps_all_threads"].as_f64().unwrap_or(0.0),
+            r["speedup_all_threads"].as_f64().unwrap_or(0.0)
+        );
+        if let Some(st) = r["stage_ms_1thread"].as_object() {
+            for (k, ms) in st {
+                println!("          {k:<20} {:.3} ms", ms.as_f64().unwrap_or(0.0));
+            }
+        }
+    }
+    if let Some(m) = v["peak_rss_mb"].as_f64() {
+        println!("peak resident memory: {m:.1} MiB");
+    }
+    Ok(())
+}

@@ -1,0 +1,157 @@
+//! `ocellus saliency`: saliency maps, overlays and raw values for images and folders.
+
+use crate::{config_file, inputs, overlay};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use ocellus_attention::{SaliencyConfig, SaliencyEngine};
+use ocellus_image::{convert, Plane};
+use std::path::{Path, PathBuf};
+
+/// Arguments of `ocellus saliency`.
+#[derive(Args, Debug)]
+pub struct SaliencyArgs {
+    /// Image files (PNG, JPEG, PNM) or folders of them (read in natural order).
+    #[arg(required_unless_present = "print_config")]
+    pub images: Vec<PathBuf>,
+    /// Parameter preset: `ace2009` (the seed's parameters) or `stb` (SaliencyToolbox defaults).
+    #[arg(long, default_value = "ace2009")]
+    pub preset: String,
+    /// TOML file overriding any preset field (field names as printed by --print-config).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Output folder (created if missing).
+    #[arg(long, default_value = "ocellus-out")]
+    pub out: PathBuf,
+    /// Also write each channel's conspicuity map (PNG and NPY).
+    #[arg(long)]
+    pub conspicuity: bool,
+    /// Print the time of each pipeline stage for every image (milliseconds).
+    #[arg(long)]
+    pub timings: bool,
+    /// Print the effective configuration as TOML and exit.
+    #[arg(long)]
+    pub print_config: bool,
+}
+
+/// What one image produced.
+pub struct SaliencyResult {
+    /// Map-level size (w, h).
+    pub map_size: (usize, usize),
+    /// Most salient location in input pixels (x, y), centre of the winning map cell.
+    pub peak_px: (f32, f32),
+    /// Files written.
+    pub files: Vec<PathBuf>,
+}
+
+fn write_map(out: &Path, name: &str, map: &Plane<f32>, files: &mut Vec<PathBuf>) -> Result<()> {
+    let (_, mx) = map.min_max();
+    let png = out.join(format!("{name}.png"));
+    ocellus_io::write_png(&png, &convert::to_image_gray8(map, 0.0, if mx > 0.0 { mx } else { 1.0 }))?;
+    let npy = out.join(format!("{name}.npy"));
+    ocellus_io::npy::write_plane(&npy, map)?;
+    files.extend([png, npy]);
+    Ok(())
+}
+
+/// Computes and writes the outputs of one image with `engine` (rebuilt when the size changes).
+pub fn process_one(
+    path: &Path,
+    cfg: &SaliencyConfig,
+    engine: &mut Option<SaliencyEngine>,
+    out: &Path,
+    conspicuity: bool,
+) -> Result<SaliencyResult> {
+    let img = ocellus_io::read_image(path)?;
+    let (w, h) = img.size();
+    if engine.as_ref().map(|e| e.frame_size()) != Some((w, h)) {
+        *engine = Some(SaliencyEngine::new(cfg.clone(), w, h).with_context(|| format!("{}", path.display()))?);
+    }
+    let Some(e) = engine.as_mut() else { bail!("engine missing") };
+    e.process(&img).with_context(|| format!("{}", path.display()))?;
+    let stem = inputs::stem(path);
+    let mut files = Vec::new();
+    write_map(out, &format!("{stem}.saliency"), e.saliency(), &mut files)?;
+    let mut full = Plane::default();
+    e.saliency_full_size(&mut full)?;
+    let ov = out.join(format!("{stem}.overlay.png"));
+    ocellus_io::write_png(&ov, &convert::to_image_rgb8(&overlay::overlay(&img.to_u8(), &full)))?;
+    files.push(ov);
+    if conspicuity {
+        let maps: Vec<(String, Plane<f32>)> =
+            e.conspicuity_maps().map(|(l, m)| (l.replace(':', "-"), m.clone())).collect();
+        for (label, m) in maps {
+            write_map(out, &format!("{stem}.conspicuity.{label}"), &m, &mut files)?;
+        }
+    }
+    let s = e.saliency();
+    let (mw, mh) = s.size();
+    let (mut best, mut bx, mut by) = (f32::NEG_INFINITY, 0, 0);
+    for y in 0..mh {
+        for (x, &v) in s.row(y).iter().enumerate() {
+            if v > best {
+                (best, bx, by) = (v, x, y);
+            }
+        }
+    }
+    let peak_px = ((bx as f32 + 0.5) * w as f32 / mw as f32, (by as f32 + 0.5) * h as f32 / mh as f32);
+    Ok(SaliencyResult { map_size: (mw, mh), peak_px, files })
+}
+
+/// Runs the subcommand.
+pub fn run(a: SaliencyArgs) -> Result<()> {
+    let cfg = config_file::load(&a.preset, a.config.as_deref())?;
+    if a.print_config {
+        print!("{}", config_file::to_toml(&cfg)?);
+        return Ok(());
+    }
+    let files = inputs::collect_images(&a.images)?;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create output folder {}", a.out.display()))?;
+    let bar = if files.len() > 1 {
+        let b = ProgressBar::new(files.len() as u64);
+        b.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}").unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let mut engine = None;
+    let mut failed = 0;
+    for f in &files {
+        bar.set_message(inputs::stem(f));
+        match process_one(f, &cfg, &mut engine, &a.out, a.conspicuity) {
+            Ok(r) => {
+                bar.suspend(|| {
+                    println!(
+                        "{}: map {}x{}, most salient at ({:.0}, {:.0}) px",
+                        f.display(),
+                        r.map_size.0,
+                        r.map_size.1,
+                        r.peak_px.0,
+                        r.peak_px.1
+                    );
+                    if a.timings {
+                        if let Some(e) = &engine {
+                            let t = e.timings();
+                            let parts: Vec<String> =
+                                t.stages().iter().map(|(n, d)| format!("{n} {:.3}", d.as_secs_f64() * 1e3)).collect();
+                            println!("  timings ms: {}; total {:.3}", parts.join(", "), t.total().as_secs_f64() * 1e3);
+                        }
+                    }
+                });
+            }
+            Err(e) => {
+                failed += 1;
+                bar.suspend(|| eprintln!("error: {e:#}"));
+            }
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    println!("wrote maps to {}", a.out.display());
+    if failed > 0 {
+        bail!("{failed} of {} images failed", files.len());
+    }
+    Ok(())
+}
