@@ -10,7 +10,7 @@ use crate::gabor::GaborBank;
 use crate::normalize::Normalizer;
 use crate::{AttentionError, Result};
 use ocellus_image::convert::RgbImage;
-use ocellus_image::pyramid::{level_sizes, pyr_down, PyrScratch};
+use ocellus_image::pyramid::{level_sizes, pyr_down, pyr_down_rgb8, PyrScratch};
 use ocellus_image::resample::{ResampleMethod, Resampler};
 use ocellus_image::{Backend, Plane};
 use std::time::{Duration, Instant};
@@ -356,9 +356,25 @@ impl SaliencyEngine {
                 }
                 OpponencyStage::EachLevel => {
                     let [r, g, bl] = &mut self.rgb;
-                    split_rgb(b, frame, [&mut r[0], &mut g[0], &mut bl[0]]);
+                    let first = match frame {
+                        // 8-bit input: conversion fused into the first level (no full-size floats).
+                        RgbImage::U8(p) if top >= 1 => {
+                            pyr_down_rgb8(
+                                b,
+                                p,
+                                [&mut r[1], &mut g[1], &mut bl[1]],
+                                &cfg.pyramid,
+                                &mut self.pyr_scratch,
+                            )?;
+                            1
+                        }
+                        _ => {
+                            split_rgb(b, frame, [&mut r[0], &mut g[0], &mut bl[0]]);
+                            0
+                        }
+                    };
                     for p in self.rgb.iter_mut() {
-                        Self::pyramid_up(b, p, 0, top, &cfg.pyramid, &mut self.pyr_scratch)?;
+                        Self::pyramid_up(b, p, first, top, &cfg.pyramid, &mut self.pyr_scratch)?;
                     }
                     for &l in &self.used_levels {
                         let [i, rg, by] = &mut self.opp;

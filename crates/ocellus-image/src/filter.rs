@@ -27,33 +27,68 @@ pub struct FilterScratch {
 
 const CHUNK: usize = 32;
 
+/// Sum over taps `i` of `w(i) * s(i)[0..8]` with four independent chains (taps dealt in
+/// groups of four), so the multiply-add latency does not serialize short rows.
+#[inline(always)]
+fn dot8<'a, M: Madd>(n: usize, w: impl Fn(usize) -> f32, s: impl Fn(usize) -> &'a [f32; 8]) -> [f32; 8] {
+    let (mut a0, mut a1, mut a2, mut a3) = ([0f32; 8], [0f32; 8], [0f32; 8], [0f32; 8]);
+    let mut t = 0;
+    while t + 4 <= n {
+        let (s0, s1, s2, s3) = (s(t), s(t + 1), s(t + 2), s(t + 3));
+        let (w0, w1, w2, w3) = (w(t), w(t + 1), w(t + 2), w(t + 3));
+        for l in 0..8 {
+            a0[l] = M::madd(w0, s0[l], a0[l]);
+            a1[l] = M::madd(w1, s1[l], a1[l]);
+            a2[l] = M::madd(w2, s2[l], a2[l]);
+            a3[l] = M::madd(w3, s3[l], a3[l]);
+        }
+        t += 4;
+    }
+    while t < n {
+        let (s0, w0) = (s(t), w(t));
+        for l in 0..8 {
+            a0[l] = M::madd(w0, s0[l], a0[l]);
+        }
+        t += 1;
+    }
+    let mut out = [0f32; 8];
+    for l in 0..8 {
+        out[l] = (a0[l] + a1[l]) + (a2[l] + a3[l]);
+    }
+    out
+}
+
+/// Sum over taps `i` of `w(i) * s(i)[0..32]` (four 256-bit chains).
+#[inline(always)]
+fn dot32<'a, M: Madd>(n: usize, w: impl Fn(usize) -> f32, s: impl Fn(usize) -> &'a [f32; CHUNK]) -> [f32; CHUNK] {
+    let mut acc = [0f32; CHUNK];
+    for t in 0..n {
+        let (st, wt) = (s(t), w(t));
+        for l in 0..CHUNK {
+            acc[l] = M::madd(wt, st[l], acc[l]);
+        }
+    }
+    acc
+}
+
 /// `out[x] = sum_t k[t] * p[x + t]` for `x < out.len()`; `p.len() >= out.len() + k.len() - 1`.
 #[inline(always)]
 pub(crate) fn correlate_padded_generic<M: Madd>(p: &[f32], k: &[f32], out: &mut [f32]) {
+    const Z32: [f32; CHUNK] = [0.0; CHUNK];
+    const Z8: [f32; 8] = [0.0; 8];
     let n = out.len();
     let mut x = 0;
-    // Many independent accumulators hide the latency of the multiply-add chain.
     while x + CHUNK <= n {
-        let mut acc = [0f32; CHUNK];
-        for (t, &kt) in k.iter().enumerate() {
-            let s: &[f32; CHUNK] = p[x + t..x + t + CHUNK].try_into().unwrap_or(&[0.0; CHUNK]);
-            for l in 0..CHUNK {
-                acc[l] = M::madd(kt, s[l], acc[l]);
-            }
-        }
+        let acc = dot32::<M>(k.len(), |t| k[t], |t| p[x + t..x + t + CHUNK].try_into().unwrap_or(&Z32));
         out[x..x + CHUNK].copy_from_slice(&acc);
         x += CHUNK;
     }
-    while x + 8 <= n {
-        let mut acc = [0f32; 8];
-        for (t, &kt) in k.iter().enumerate() {
-            let s: &[f32; 8] = p[x + t..x + t + 8].try_into().unwrap_or(&[0.0; 8]);
-            for l in 0..8 {
-                acc[l] = M::madd(kt, s[l], acc[l]);
-            }
-        }
-        out[x..x + 8].copy_from_slice(&acc);
-        x += 8;
+    // 8 at a time, the last chunk aligned to the end (recomputes a few outputs).
+    while x < n && n >= 8 {
+        let x0 = if x + 8 <= n { x } else { n - 8 };
+        let acc = dot8::<M>(k.len(), |t| k[t], |t| p[x0 + t..x0 + t + 8].try_into().unwrap_or(&Z8));
+        out[x0..x0 + 8].copy_from_slice(&acc);
+        x = x0 + 8;
     }
     while x < n {
         let mut acc = 0f32;
@@ -73,29 +108,21 @@ dispatch_kernel!(
 /// `out[x] = sum_i w_i * src.row(r_i)[x]` over `rows = [(r_i, w_i)]`.
 #[inline(always)]
 pub(crate) fn accumulate_rows_generic<M: Madd>(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32]) {
+    const Z32: [f32; CHUNK] = [0.0; CHUNK];
+    const Z8: [f32; 8] = [0.0; 8];
     let n = out.len();
     let mut x = 0;
     while x + CHUNK <= n {
-        let mut acc = [0f32; CHUNK];
-        for &(r, w) in rows {
-            let s: &[f32; CHUNK] = src.row(r)[x..x + CHUNK].try_into().unwrap_or(&[0.0; CHUNK]);
-            for l in 0..CHUNK {
-                acc[l] = M::madd(w, s[l], acc[l]);
-            }
-        }
+        let acc =
+            dot32::<M>(rows.len(), |i| rows[i].1, |i| src.row(rows[i].0)[x..x + CHUNK].try_into().unwrap_or(&Z32));
         out[x..x + CHUNK].copy_from_slice(&acc);
         x += CHUNK;
     }
-    while x + 8 <= n {
-        let mut acc = [0f32; 8];
-        for &(r, w) in rows {
-            let s: &[f32; 8] = src.row(r)[x..x + 8].try_into().unwrap_or(&[0.0; 8]);
-            for l in 0..8 {
-                acc[l] = M::madd(w, s[l], acc[l]);
-            }
-        }
-        out[x..x + 8].copy_from_slice(&acc);
-        x += 8;
+    while x < n && n >= 8 {
+        let x0 = if x + 8 <= n { x } else { n - 8 };
+        let acc = dot8::<M>(rows.len(), |i| rows[i].1, |i| src.row(rows[i].0)[x0..x0 + 8].try_into().unwrap_or(&Z8));
+        out[x0..x0 + 8].copy_from_slice(&acc);
+        x = x0 + 8;
     }
     while x < n {
         let mut acc = 0f32;
@@ -153,6 +180,44 @@ fn vertical_taps(y: usize, h: usize, k: &[f32], border: Border, rows: &mut Vec<(
     }
 }
 
+#[inline(always)]
+fn filter_rows_generic<M: Madd>(
+    src: &Plane<f32>,
+    dst: &mut Plane<f32>,
+    kx: &[f32],
+    border: Border,
+    padded: &mut Vec<f32>,
+) {
+    let hwx = (kx.len() - 1) / 2;
+    for y in 0..src.height() {
+        pad_row(src.row(y), hwx, border, padded);
+        correlate_padded_generic::<M>(padded, kx, dst.row_mut(y));
+    }
+}
+
+dispatch_kernel!(fn filter_rows_kernel => filter_rows_generic(
+    src: &Plane<f32>, dst: &mut Plane<f32>, kx: &[f32], border: Border, padded: &mut Vec<f32>
+));
+
+#[inline(always)]
+fn filter_cols_generic<M: Madd>(
+    src: &Plane<f32>,
+    dst: &mut Plane<f32>,
+    ky: &[f32],
+    border: Border,
+    rows: &mut Vec<(usize, f32)>,
+) {
+    let h = src.height();
+    for y in 0..h {
+        vertical_taps(y, h, ky, border, rows);
+        accumulate_rows_generic::<M>(src, rows, dst.row_mut(y));
+    }
+}
+
+dispatch_kernel!(fn filter_cols_kernel => filter_cols_generic(
+    src: &Plane<f32>, dst: &mut Plane<f32>, ky: &[f32], border: Border, rows: &mut Vec<(usize, f32)>
+));
+
 /// Correlates every row of `src` with `kx` (centred), `dst` resized to `src`.
 pub fn filter_rows(
     backend: Backend,
@@ -163,13 +228,8 @@ pub fn filter_rows(
     scratch: &mut FilterScratch,
 ) -> Result<()> {
     check_kernel(kx, "horizontal")?;
-    let (w, h) = src.size();
-    dst.resize(w, h);
-    let hwx = (kx.len() - 1) / 2;
-    for y in 0..h {
-        pad_row(src.row(y), hwx, border, &mut scratch.padded);
-        correlate_padded(backend, &scratch.padded, kx, dst.row_mut(y));
-    }
+    dst.resize(src.width(), src.height());
+    filter_rows_kernel(backend, src, dst, kx, border, &mut scratch.padded);
     Ok(())
 }
 
@@ -183,12 +243,8 @@ pub fn filter_cols(
     scratch: &mut FilterScratch,
 ) -> Result<()> {
     check_kernel(ky, "vertical")?;
-    let (w, h) = src.size();
-    dst.resize(w, h);
-    for y in 0..h {
-        vertical_taps(y, h, ky, border, &mut scratch.rows);
-        accumulate_rows(backend, src, &scratch.rows, dst.row_mut(y));
-    }
+    dst.resize(src.width(), src.height());
+    filter_cols_kernel(backend, src, dst, ky, border, &mut scratch.rows);
     Ok(())
 }
 
@@ -301,19 +357,37 @@ impl PreservingFilter {
                 want_h: self.height,
             });
         }
-        let hw = (self.k.len() - 1) / 2;
         dst.resize(self.width, self.height);
-        for y in 0..self.height {
-            self.padded[hw..hw + self.width].copy_from_slice(src.row(y));
-            let out = self.tmp.row_mut(y);
-            correlate_padded(backend, &self.padded, &self.k, out);
-            for (o, f) in out.iter_mut().zip(&self.fx) {
-                *o *= f;
-            }
-        }
-        for y in 0..self.height {
-            accumulate_rows(backend, &self.tmp, &self.rows[y], dst.row_mut(y));
-        }
+        preserving_kernel(backend, &self.k, &self.fx, &self.rows, &mut self.padded, &mut self.tmp, src, dst);
         Ok(())
     }
 }
+
+#[inline(always)]
+fn preserving_generic<M: Madd>(
+    k: &[f32],
+    fx: &[f32],
+    rows: &[Vec<(usize, f32)>],
+    padded: &mut [f32],
+    tmp: &mut Plane<f32>,
+    src: &Plane<f32>,
+    dst: &mut Plane<f32>,
+) {
+    let hw = (k.len() - 1) / 2;
+    let w = src.width();
+    for y in 0..src.height() {
+        padded[hw..hw + w].copy_from_slice(src.row(y));
+        let out = tmp.row_mut(y);
+        correlate_padded_generic::<M>(padded, k, out);
+        for (o, f) in out.iter_mut().zip(fx) {
+            *o *= f;
+        }
+    }
+    for (y, r) in rows.iter().enumerate() {
+        accumulate_rows_generic::<M>(tmp, r, dst.row_mut(y));
+    }
+}
+
+dispatch_kernel!(fn preserving_kernel => preserving_generic(
+    k: &[f32], fx: &[f32], rows: &[Vec<(usize, f32)>], padded: &mut [f32], tmp: &mut Plane<f32>, src: &Plane<f32>, dst: &mut Plane<f32>
+));

@@ -5,7 +5,7 @@
 //! output length is `floor(n / 2)`. Where taps fall outside the image they are dropped and
 //! the remaining taps renormalized to sum 1 (the seed's [10 10 5 1]/26 rule, generalized).
 
-use crate::filter::accumulate_rows;
+use crate::filter::accumulate_rows_generic;
 use crate::simd::Madd;
 use crate::{dispatch_kernel, Backend, ImageError, Plane, Result};
 use serde::{Deserialize, Serialize};
@@ -51,7 +51,7 @@ impl PyramidKernel {
             || s <= 0.0
         {
             return Err(ImageError::InvalidParameter(format!(
-                "pyramid kernel {:?} with origin {} must be non-empty, non-negative, finite, with the origin inside",
+                "pyramid kernel {:?} with origin {} must have 1..=16 non-negative finite taps, with the origin inside",
                 self.taps, self.origin
             )));
         }
@@ -103,21 +103,34 @@ pub struct PyrScratch {
     even: Vec<f32>,
     odd: Vec<f32>,
     taps: Vec<(usize, f32)>,
+    taps2: Vec<(usize, f32)>,
+    row3: Vec<f32>,
+    even3: [Vec<f32>; 3],
+    odd3: [Vec<f32>; 3],
 }
 
+/// Longest pyramid kernel supported (taps).
+pub const MAX_TAPS: usize = 16;
+
+/// `out[j] = sum_t k[t] x[2 (lo + j) + t - origin]` where `x[2i] = even[i]`, `x[2i+1] = odd[i]`;
+/// all taps must fall inside the row.
 #[inline(always)]
 fn decimate_interior_generic<M: Madd>(even: &[f32], odd: &[f32], k: &[f32], origin: usize, lo: usize, out: &mut [f32]) {
-    // x[2j + d] is even[j + d/2] for even d and odd[j + (d-1)/2] for odd d.
-    const C: usize = 8;
+    // Per tap: which half-row it reads and at which offset from j.
+    let mut plan = [(false, 0usize, 0f32); MAX_TAPS];
+    for (t, &kt) in k.iter().enumerate().take(MAX_TAPS) {
+        let i = 2 * lo as isize + t as isize - origin as isize; // input index for j = 0
+        plan[t] = (i.rem_euclid(2) == 1, i.div_euclid(2) as usize, kt);
+    }
+    let plan = &plan[..k.len().min(MAX_TAPS)];
+    const C: usize = 32;
     let n = out.len();
     let mut j = 0;
     while j + C <= n {
         let mut acc = [0f32; C];
-        for (t, &kt) in k.iter().enumerate() {
-            let d = t as isize - origin as isize;
-            let (src, base) = if d.rem_euclid(2) == 0 { (even, d.div_euclid(2)) } else { (odd, (d - 1).div_euclid(2)) };
-            let s0 = (lo + j) as isize + base;
-            let s: &[f32; C] = src[s0 as usize..s0 as usize + C].try_into().unwrap_or(&[0.0; C]);
+        for &(is_odd, base, kt) in plan {
+            let src = if is_odd { odd } else { even };
+            let s: &[f32; C] = src[base + j..base + j + C].try_into().unwrap_or(&[0.0; C]);
             for l in 0..C {
                 acc[l] = M::madd(kt, s[l], acc[l]);
             }
@@ -125,22 +138,66 @@ fn decimate_interior_generic<M: Madd>(even: &[f32], odd: &[f32], k: &[f32], orig
         out[j..j + C].copy_from_slice(&acc);
         j += C;
     }
+    // 8 at a time, then one 8-wide chunk aligned to the end (recomputes a few outputs).
+    while j < n && n >= 8 {
+        let j0 = if j + 8 <= n { j } else { n - 8 };
+        let mut acc = [0f32; 8];
+        for &(is_odd, base, kt) in plan {
+            let src = if is_odd { odd } else { even };
+            let s: &[f32; 8] = src[base + j0..base + j0 + 8].try_into().unwrap_or(&[0.0; 8]);
+            for l in 0..8 {
+                acc[l] = M::madd(kt, s[l], acc[l]);
+            }
+        }
+        out[j0..j0 + 8].copy_from_slice(&acc);
+        j = j0 + 8;
+    }
     while j < n {
         let mut acc = 0f32;
-        for (t, &kt) in k.iter().enumerate() {
-            let d = t as isize - origin as isize;
-            let i = (2 * (lo + j)) as isize + d;
-            let v = if i % 2 == 0 { even[(i / 2) as usize] } else { odd[(i / 2) as usize] };
-            acc = M::madd(kt, v, acc);
+        for &(is_odd, base, kt) in plan {
+            acc = M::madd(kt, if is_odd { odd[base + j] } else { even[base + j] }, acc);
         }
         out[j] = acc;
         j += 1;
     }
 }
 
-dispatch_kernel!(fn decimate_interior => decimate_interior_generic(
-    even: &[f32], odd: &[f32], k: &[f32], origin: usize, lo: usize, out: &mut [f32]
-));
+/// Splits `row` into even- and odd-indexed samples.
+#[inline(always)]
+fn deinterleave(row: &[f32], even: &mut Vec<f32>, odd: &mut Vec<f32>) {
+    let n = row.len();
+    even.resize(n.div_ceil(2), 0.0);
+    odd.resize(n / 2, 0.0);
+    let (e, o): (&mut [f32], &mut [f32]) = (&mut even[..], &mut odd[..]);
+    for (i, pair) in row.chunks_exact(2).enumerate() {
+        e[i] = pair[0];
+        o[i] = pair[1];
+    }
+    if n % 2 == 1 {
+        e[n / 2] = row[n - 1];
+    }
+}
+
+/// One decimated row: `out[j] = sum_t k[t] x[2j + t - origin]`, renormalized at the borders,
+/// from the even/odd halves of a row of length `w`.
+#[inline(always)]
+fn decimate_one<M: Madd>(
+    even: &[f32],
+    odd: &[f32],
+    w: usize,
+    kernel: &PyramidKernel,
+    taps: &mut Vec<(usize, f32)>,
+    out: &mut [f32],
+) {
+    let (lo, hi) = kernel.interior(w);
+    if hi > lo {
+        decimate_interior_generic::<M>(even, odd, &kernel.taps, kernel.origin, lo, &mut out[lo..hi]);
+    }
+    for j in (0..lo).chain(hi.max(lo)..out.len()) {
+        kernel.taps_for(j, w, taps);
+        out[j] = taps.iter().map(|&(i, wt)| wt * if i % 2 == 0 { even[i / 2] } else { odd[i / 2] }).sum();
+    }
+}
 
 /// One pyramid level: `dst` becomes the low-passed, decimated `src` (`floor(w/2)` x `floor(h/2)`).
 ///
@@ -158,32 +215,145 @@ pub fn pyr_down(
             "cannot decimate a {w}x{h} image: both sides must be at least 2"
         )));
     }
+    pyr_down_kernel(backend, src, dst, kernel, s);
+    Ok(())
+}
+
+#[inline(always)]
+fn pyr_down_generic<M: Madd>(src: &Plane<f32>, dst: &mut Plane<f32>, kernel: &PyramidKernel, s: &mut PyrScratch) {
+    let (w, h) = src.size();
     let (ow, oh) = next_size(w, h);
     // Vertical first: full-width rows vectorize without shuffles.
     s.vert.resize(w, oh);
     for j in 0..oh {
         kernel.taps_for(j, h, &mut s.taps);
-        accumulate_rows(backend, src, &s.taps, s.vert.row_mut(j));
+        accumulate_rows_generic::<M>(src, &s.taps, s.vert.row_mut(j));
     }
     dst.resize(ow, oh);
-    let (lo, hi) = kernel.interior(w);
-    for y in 0..oh {
-        let row = s.vert.row(y);
-        s.even.clear();
-        s.odd.clear();
-        s.even.extend(row.iter().step_by(2));
-        s.odd.extend(row.iter().skip(1).step_by(2));
-        let out = dst.row_mut(y);
-        if hi > lo {
-            decimate_interior(backend, &s.even, &s.odd, &kernel.taps, kernel.origin, lo, &mut out[lo..hi]);
-        }
-        for j in (0..lo).chain(hi.max(lo)..ow) {
-            kernel.taps_for(j, w, &mut s.taps);
-            out[j] = s.taps.iter().map(|&(i, wt)| wt * row[i]).sum();
-        }
+    decimate_rows::<M>(&s.vert, dst, kernel, &mut s.even, &mut s.odd, &mut s.taps);
+}
+
+dispatch_kernel!(fn pyr_down_kernel => pyr_down_generic(src: &Plane<f32>, dst: &mut Plane<f32>, kernel: &PyramidKernel, s: &mut PyrScratch));
+
+/// Horizontal low-pass and decimation of every row of `vert` into `dst` (already sized).
+#[inline(always)]
+fn decimate_rows<M: Madd>(
+    vert: &Plane<f32>,
+    dst: &mut Plane<f32>,
+    kernel: &PyramidKernel,
+    even: &mut Vec<f32>,
+    odd: &mut Vec<f32>,
+    taps: &mut Vec<(usize, f32)>,
+) {
+    let w = vert.width();
+    for y in 0..dst.height() {
+        deinterleave(vert.row(y), even, odd);
+        decimate_one::<M>(even, odd, w, kernel, taps, dst.row_mut(y));
     }
+}
+
+/// First pyramid level straight from 8-bit interleaved RGB: `dst[c]` becomes level 1 of
+/// channel c with values in [0, 1]. The same result as converting to float planes and
+/// calling [`pyr_down`] on each, without writing the full-resolution float planes.
+pub fn pyr_down_rgb8(
+    backend: Backend,
+    src: &Plane<[u8; 3]>,
+    dst: [&mut Plane<f32>; 3],
+    kernel: &PyramidKernel,
+    s: &mut PyrScratch,
+) -> Result<()> {
+    let (w, h) = src.size();
+    if w < 2 || h < 2 {
+        return Err(ImageError::InvalidParameter(format!(
+            "cannot decimate a {w}x{h} image: both sides must be at least 2"
+        )));
+    }
+    let (ow, oh) = next_size(w, h);
+    let [d0, d1, d2] = dst;
+    for d in [&mut *d0, &mut *d1, &mut *d2] {
+        d.resize(ow, oh);
+    }
+    pyr_down_rgb8_kernel(backend, src, [d0, d1, d2], kernel, s);
     Ok(())
 }
+
+#[inline(always)]
+fn pyr_down_rgb8_generic<M: Madd>(
+    src: &Plane<[u8; 3]>,
+    dst: [&mut Plane<f32>; 3],
+    kernel: &PyramidKernel,
+    s: &mut PyrScratch,
+) {
+    let (w, h) = src.size();
+    let [d0, d1, d2] = dst;
+    s.row3.resize(3 * w, 0.0);
+    for c in 0..3 {
+        s.even3[c].resize(w.div_ceil(2), 0.0);
+        s.odd3[c].resize(w / 2, 0.0);
+    }
+    const SCALE: f32 = 1.0 / 255.0;
+    for j in 0..d0.height() {
+        kernel.taps_for(j, h, &mut s.taps);
+        // Vertical pass on the interleaved bytes, 32 values at a time.
+        let out = &mut s.row3[..];
+        let n = out.len();
+        let mut x = 0;
+        while x + 32 <= n {
+            let mut acc = [0f32; 32];
+            for &(r, wt) in s.taps.iter() {
+                let row: &[u8; 32] = src.row(r).as_flattened()[x..x + 32].try_into().unwrap_or(&[0; 32]);
+                let wt = wt * SCALE;
+                for l in 0..32 {
+                    acc[l] = M::madd(wt, row[l] as f32, acc[l]);
+                }
+            }
+            out[x..x + 32].copy_from_slice(&acc);
+            x += 32;
+        }
+        if x < n && n >= 32 {
+            let x0 = n - 32;
+            let mut acc = [0f32; 32];
+            for &(r, wt) in s.taps.iter() {
+                let row: &[u8; 32] = src.row(r).as_flattened()[x0..x0 + 32].try_into().unwrap_or(&[0; 32]);
+                let wt = wt * SCALE;
+                for l in 0..32 {
+                    acc[l] = M::madd(wt, row[l] as f32, acc[l]);
+                }
+            }
+            out[x0..x0 + 32].copy_from_slice(&acc);
+            x = n;
+        }
+        for (xx, o) in out.iter_mut().enumerate().skip(x) {
+            *o = s.taps.iter().map(|&(r, wt)| wt * SCALE * src.row(r).as_flattened()[xx] as f32).sum();
+        }
+        // Split into even/odd samples per channel (two RGB pixels = 6 values at a time).
+        let [e0, e1, e2] = &mut s.even3;
+        let [o0, o1, o2] = &mut s.odd3;
+        // Plain slices: indexing a Vec inside the loop would reload its header every time.
+        let half = w / 2;
+        let (e0, e1, e2): (&mut [f32], &mut [f32], &mut [f32]) = (&mut e0[..], &mut e1[..], &mut e2[..]);
+        let (o0, o1, o2) = (&mut o0[..half], &mut o1[..half], &mut o2[..half]);
+        for (k, px) in s.row3.chunks_exact(6).take(half).enumerate() {
+            e0[k] = px[0];
+            e1[k] = px[1];
+            e2[k] = px[2];
+            o0[k] = px[3];
+            o1[k] = px[4];
+            o2[k] = px[5];
+        }
+        if w % 2 == 1 {
+            let last = &s.row3[3 * (w - 1)..];
+            e0[w / 2] = last[0];
+            e1[w / 2] = last[1];
+            e2[w / 2] = last[2];
+        }
+        for (c, d) in [&mut *d0, &mut *d1, &mut *d2].into_iter().enumerate() {
+            decimate_one::<M>(&s.even3[c], &s.odd3[c], w, kernel, &mut s.taps2, d.row_mut(j));
+        }
+    }
+}
+
+dispatch_kernel!(fn pyr_down_rgb8_kernel => pyr_down_rgb8_generic(src: &Plane<[u8; 3]>, dst: [&mut Plane<f32>; 3], kernel: &PyramidKernel, s: &mut PyrScratch));
 
 /// Allocating convenience wrapper of [`pyr_down`] (auto-detected backend).
 pub fn pyr_down_alloc(src: &Plane<f32>, kernel: &PyramidKernel) -> Result<Plane<f32>> {

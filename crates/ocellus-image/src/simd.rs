@@ -95,24 +95,24 @@ impl Madd for Fused {
     }
 }
 
-/// Defines `$name(backend, args..)` that runs `$generic::<Plain>` or, on AVX2 + FMA
-/// CPUs, `$generic::<Fused>` compiled with those features enabled.
+/// Defines `$name(backend, args..) -> ret` that runs `$generic::<Plain>` or, on AVX2 + FMA
+/// CPUs, `$generic::<Fused>` compiled with those features enabled. Dispatch once per plane,
+/// not per row, so the whole loop nest is compiled for the chosen features.
 #[macro_export]
 macro_rules! dispatch_kernel {
-    ($(#[$m:meta])* $vis:vis fn $name:ident => $generic:ident ( $($arg:ident : $ty:ty),* $(,)? )) => {
+    ($(#[$m:meta])* $vis:vis fn $name:ident => $generic:ident ( $($arg:ident : $ty:ty),* $(,)? ) $(-> $ret:ty)?) => {
         $(#[$m])*
         #[inline]
-        $vis fn $name(backend: $crate::Backend, $($arg: $ty),*) {
+        $vis fn $name(backend: $crate::Backend, $($arg: $ty),*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx2,fma")]
-                unsafe fn avx2($($arg: $ty),*) {
+                unsafe fn avx2($($arg: $ty),*) $(-> $ret)? {
                     $generic::<$crate::simd::Fused>($($arg),*)
                 }
                 if backend.resolve() == $crate::Backend::Avx2 {
                     // SAFETY: resolve() returns Avx2 only when the CPU supports AVX2 and FMA.
-                    unsafe { avx2($($arg),*) };
-                    return;
+                    return unsafe { avx2($($arg),*) };
                 }
             }
             let _ = backend;
