@@ -139,6 +139,110 @@ dispatch_kernel!(
     pub fn accumulate_rows => accumulate_rows_generic(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32])
 );
 
+/// Symmetry of a centred kernel: `k[h+t] = k[h-t]` (even) or `k[h+t] = -k[h-t]` (odd).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Symmetry {
+    /// Even: `k[h+t] == k[h-t]`.
+    Even,
+    /// Odd: `k[h+t] == -k[h-t]` (and `k[h] == 0`).
+    Odd,
+    /// Neither.
+    None,
+}
+
+/// The symmetry of `k` (exact comparison; odd length assumed).
+pub fn symmetry(k: &[f32]) -> Symmetry {
+    let h = k.len() / 2;
+    if (1..=h).all(|t| k[h + t] == k[h - t]) {
+        Symmetry::Even
+    } else if k[h] == 0.0 && (1..=h).all(|t| k[h + t] == -k[h - t]) {
+        Symmetry::Odd
+    } else {
+        Symmetry::None
+    }
+}
+
+/// Output x of a folded correlation over `n` outputs, reading value `i` of pair `t` through
+/// `plus(t, x0)` / `minus(t, x0)` slices of length L: `k[h] c + sum_t k[h+t] (plus ± minus)`.
+#[inline(always)]
+fn fold_chunk<'a, M: Madd, const L: usize>(
+    k: &[f32],
+    odd: bool,
+    centre: &'a [f32; L],
+    plus: impl Fn(usize) -> &'a [f32; L],
+    minus: impl Fn(usize) -> &'a [f32; L],
+) -> [f32; L] {
+    let h = k.len() / 2;
+    let mut acc = [0f32; L];
+    if !odd {
+        for l in 0..L {
+            acc[l] = k[h] * centre[l];
+        }
+    }
+    for t in 1..=h {
+        let (sp, sm, kt) = (plus(t), minus(t), k[h + t]);
+        if odd {
+            for l in 0..L {
+                acc[l] = M::madd(kt, sp[l] - sm[l], acc[l]);
+            }
+        } else {
+            for l in 0..L {
+                acc[l] = M::madd(kt, sp[l] + sm[l], acc[l]);
+            }
+        }
+    }
+    acc
+}
+
+/// Folded correlation of a padded row: `out[x] = sum_t k[t] p[x + t]` for an even or odd `k`.
+#[inline(always)]
+fn correlate_folded_generic<M: Madd>(p: &[f32], k: &[f32], odd: bool, out: &mut [f32]) {
+    const Z32: [f32; CHUNK] = [0.0; CHUNK];
+    const Z8: [f32; 8] = [0.0; 8];
+    let h = k.len() / 2;
+    let n = out.len();
+    let mut x = 0;
+    while x + CHUNK <= n {
+        let c: &[f32; CHUNK] = p[x + h..x + h + CHUNK].try_into().unwrap_or(&Z32);
+        let acc = fold_chunk::<M, CHUNK>(
+            k,
+            odd,
+            c,
+            |t| p[x + h + t..x + h + t + CHUNK].try_into().unwrap_or(&Z32),
+            |t| p[x + h - t..x + h - t + CHUNK].try_into().unwrap_or(&Z32),
+        );
+        out[x..x + CHUNK].copy_from_slice(&acc);
+        x += CHUNK;
+    }
+    while x < n && n >= 8 {
+        let x0 = if x + 8 <= n { x } else { n - 8 };
+        let c: &[f32; 8] = p[x0 + h..x0 + h + 8].try_into().unwrap_or(&Z8);
+        let acc = fold_chunk::<M, 8>(
+            k,
+            odd,
+            c,
+            |t| p[x0 + h + t..x0 + h + t + 8].try_into().unwrap_or(&Z8),
+            |t| p[x0 + h - t..x0 + h - t + 8].try_into().unwrap_or(&Z8),
+        );
+        out[x0..x0 + 8].copy_from_slice(&acc);
+        x = x0 + 8;
+    }
+    while x < n {
+        out[x] = k.iter().enumerate().map(|(t, &kt)| kt * p[x + t]).sum();
+        x += 1;
+    }
+}
+
+/// Any kernel on a padded row, folded when it is even or odd.
+#[inline(always)]
+fn correlate_any_generic<M: Madd>(p: &[f32], k: &[f32], sym: Symmetry, out: &mut [f32]) {
+    match sym {
+        Symmetry::Even => correlate_folded_generic::<M>(p, k, false, out),
+        Symmetry::Odd => correlate_folded_generic::<M>(p, k, true, out),
+        Symmetry::None => correlate_padded_generic::<M>(p, k, out),
+    }
+}
+
 fn check_kernel(k: &[f32], what: &str) -> Result<()> {
     if k.is_empty() || k.len() % 2 == 0 {
         return Err(ImageError::InvalidParameter(format!(
@@ -189,9 +293,10 @@ fn filter_rows_generic<M: Madd>(
     padded: &mut Vec<f32>,
 ) {
     let hwx = (kx.len() - 1) / 2;
+    let sym = symmetry(kx);
     for y in 0..src.height() {
         pad_row(src.row(y), hwx, border, padded);
-        correlate_padded_generic::<M>(padded, kx, dst.row_mut(y));
+        correlate_any_generic::<M>(padded, kx, sym, dst.row_mut(y));
     }
 }
 
@@ -378,7 +483,7 @@ fn preserving_generic<M: Madd>(
     for y in 0..src.height() {
         padded[hw..hw + w].copy_from_slice(src.row(y));
         let out = tmp.row_mut(y);
-        correlate_padded_generic::<M>(padded, k, out);
+        correlate_any_generic::<M>(padded, k, symmetry(k), out);
         for (o, f) in out.iter_mut().zip(fx) {
             *o *= f;
         }
