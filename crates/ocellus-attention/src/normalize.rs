@@ -18,13 +18,13 @@ pub fn gaussian_kernel(peak: f32, sigma: f32, max_hw: usize) -> Vec<f32> {
     (-(hw as isize)..=hw as isize).map(|i| (peak as f64 * (-((i * i) as f64) / s2).exp()) as f32).collect()
 }
 
-/// Linearly maps the map's [min, max] to [0, range]; a flat map becomes `range / 2`
-/// everywhere (SaliencyToolbox `normalizeImage`).
-pub fn scale_to_range(map: &mut Plane<f32>, range: f32) {
+/// Linearly maps the map's [min, max] to [0, range]; a flat map (max - min <= `flat_tolerance`)
+/// becomes `range / 2` everywhere (SaliencyToolbox `normalizeImage`).
+pub fn scale_to_range(map: &mut Plane<f32>, range: f32, flat_tolerance: f32) {
     let (mn, mx) = map.min_max();
     for y in 0..map.height() {
         let row = map.row_mut(y);
-        if mx > mn {
+        if mx - mn > flat_tolerance {
             let s = range / (mx - mn);
             row.iter_mut().for_each(|v| *v = (*v - mn) * s);
         } else {
@@ -47,11 +47,13 @@ pub struct Normalizer {
     inhibition: Option<PreservingFilter>,
     excit: Plane<f32>,
     inhib: Plane<f32>,
+    flat_tolerance: f32,
 }
 
 impl Normalizer {
     /// Builds N(.) for `width` x `height` maps.
-    pub fn new(kind: &Normalization, width: usize, height: usize) -> Result<Self> {
+    /// `flat_tolerance`: maps whose range is at most this are treated as flat before scaling.
+    pub fn new(kind: &Normalization, width: usize, height: usize, flat_tolerance: f32) -> Result<Self> {
         let (mut excitation, mut inhibition) = (None, None);
         if let Normalization::Iterative {
             excitation_sigma_frac,
@@ -76,6 +78,7 @@ impl Normalizer {
             inhibition,
             excit: Plane::new(width, height),
             inhib: Plane::new(width, height),
+            flat_tolerance,
         })
     }
 
@@ -84,7 +87,7 @@ impl Normalizer {
     pub fn apply(&mut self, backend: Backend, map: &mut Plane<f32>, range: Option<f32>) -> Result<()> {
         clamp_negative(map);
         if let Some(r) = range {
-            scale_to_range(map, r);
+            scale_to_range(map, r, self.flat_tolerance);
         }
         match &self.kind {
             Normalization::None => Ok(()),

@@ -180,7 +180,7 @@ impl SaliencyEngine {
         }
         let gabor = has(&ChannelKind::Orientation).then(|| GaborBank::new(&cfg.gabor));
         let n_angles = cfg.gabor.angles_deg.len();
-        let normalizer = Normalizer::new(&cfg.normalization, map_size.0, map_size.1)?;
+        let normalizer = Normalizer::new(&cfg.normalization, map_size.0, map_size.1, cfg.flat_tolerance)?;
         let features = pairs
             .iter()
             .enumerate()
@@ -358,7 +358,7 @@ impl SaliencyEngine {
                     let [r, g, bl] = &mut self.rgb;
                     let first = match frame {
                         // 8-bit input: conversion fused into the first level (no full-size floats).
-                        RgbImage::U8(p) if top >= 1 => {
+                        RgbImage::U8(p) if top >= 1 && self.used_levels.first().is_some_and(|&l| l >= 1) => {
                             pyr_down_rgb8(
                                 b,
                                 p,
