@@ -227,7 +227,9 @@ impl SaliencyConfig {
     /// The seed's parameters (seed 001 section 4; SPEC 1): 6-tap [1 5 10 10 5 1]/32 pyramid,
     /// 19x19 Gabor (lambda 7, sigma 7/3, clamped border), centres 2-4, deltas 3-4, map level 4,
     /// bilinear across-scale, iterative DoG normalization (3 iterations, C_inh = 0.02),
-    /// equal weights.
+    /// equal weights. The seed does not say how feature-map borders are treated; like iLab's
+    /// toolkit and the SaliencyToolbox we attenuate them with a linear ramp of max(w, h) / 20
+    /// map pixels, because otherwise the frame edge produces false maxima (SPEC 1.6).
     pub fn ace2009() -> Self {
         Self {
             preset: "ace2009".into(),
@@ -247,7 +249,7 @@ impl SaliencyConfig {
             deltas: vec![3, 4],
             map_level: 4,
             across_scale: ResampleMethod::Bilinear,
-            border_ramp_frac: 0.0,
+            border_ramp_frac: 1.0 / 20.0,
             normalization: Normalization::Iterative {
                 iterations: 3,
                 excitation_sigma_frac: 0.02,
@@ -283,7 +285,6 @@ impl SaliencyConfig {
         c.gabor.sigma_px = 2.3333;
         c.gabor.border = GaborBorder::StbCompat;
         c.across_scale = ResampleMethod::Nearest;
-        c.border_ramp_frac = 1.0 / 20.0;
         if let Normalization::Iterative { global_inhibition, .. } = &mut c.normalization {
             *global_inhibition = GlobalInhibition::RelativeToMax(0.02);
         }

@@ -1,0 +1,108 @@
+//! The `ocellus` binary as a user runs it.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn ocellus() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_ocellus"))
+}
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ocellus-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn saliency_writes_maps_overlay_and_conspicuity() {
+    let out = tmpdir("sal");
+    let img = ocellus_testdata::asset("chelsea.png");
+    let o = ocellus()
+        .args(["saliency", "--preset", "stb", "--conspicuity", "--timings", "--out"])
+        .arg(&out)
+        .arg(&img)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{stdout} {}", String::from_utf8_lossy(&o.stderr));
+    assert!(stdout.contains("most salient at"), "{stdout}");
+    assert!(stdout.contains("normalization"), "timings printed: {stdout}");
+    for f in
+        ["chelsea.saliency.png", "chelsea.saliency.npy", "chelsea.overlay.png", "chelsea.conspicuity.orientation.npy"]
+    {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let map = ocellus_io::npy::read(out.join("chelsea.saliency.npy")).unwrap();
+    assert_eq!(map.shape, vec![18, 28], "451x300 -> level 4 is 28x18");
+    let ov = image::open(out.join("chelsea.overlay.png")).unwrap();
+    assert_eq!((ov.width(), ov.height()), (451, 300));
+}
+
+#[test]
+fn folders_and_bad_inputs() {
+    let dir = tmpdir("folder");
+    for n in ["b10.png", "b2.png"] {
+        std::fs::copy(ocellus_testdata::asset("coffee.png"), dir.join(n)).unwrap();
+    }
+    std::fs::write(dir.join("broken.png"), b"not a png").unwrap();
+    let out = tmpdir("folder-out");
+    let o = ocellus().arg("saliency").arg(&dir).arg("--out").arg(&out).output().unwrap();
+    assert!(!o.status.success(), "a broken file makes the run fail");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("broken.png") && stderr.contains("1 of 3 images failed"), "{stderr}");
+    assert!(
+        out.join("b2.overlay.png").is_file() && out.join("b10.overlay.png").is_file(),
+        "good files still processed"
+    );
+
+    let o = ocellus().args(["saliency", "/no/such/image.png"]).output().unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no such file"));
+
+    let tiny = dir.join("tiny.ppm");
+    std::fs::write(&tiny, b"P6\n4 4\n255\n".iter().copied().chain(std::iter::repeat_n(9u8, 48)).collect::<Vec<u8>>())
+        .unwrap();
+    let o = ocellus().arg("saliency").arg(&tiny).arg("--out").arg(&out).output().unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("4x4"), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+#[test]
+fn config_file_overrides_preset() {
+    let dir = tmpdir("cfg");
+    let cfg = dir.join("c.toml");
+    std::fs::write(&cfg, "map_level = 3\n[gabor]\nsize = 15\n").unwrap();
+    let o = ocellus().args(["saliency", "--print-config", "--config"]).arg(&cfg).output().unwrap();
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success());
+    assert!(s.contains("map_level = 3") && s.contains("size = 15"), "{s}");
+    let o = ocellus().args(["saliency", "--preset", "nope", "--print-config"]).output().unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown preset"));
+}
+
+#[test]
+fn bench_prints_json_with_named_units() {
+    let o = ocellus()
+        .args(["bench", "saliency", "--json", "--frames", "3", "--width", "320", "--height", "256"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    for p in ["ace2009", "stb"] {
+        assert!(v[p]["ms_per_frame_1thread"].as_f64().unwrap() > 0.0);
+        assert!(v[p]["fps_all_threads"].as_f64().unwrap() > 0.0);
+        assert!(v[p]["stage_ms_1thread"]["normalization"].as_f64().is_some());
+    }
+    assert!(v["peak_rss_mb"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn demo_runs_on_built_in_images() {
+    let out = tmpdir("demo");
+    let o = ocellus().arg("demo").arg("--out").arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("ace2009/astronaut.overlay.png").is_file());
+    assert!(out.join("stb/rocket.saliency.npy").is_file());
+}
