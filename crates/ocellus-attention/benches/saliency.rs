@@ -1,5 +1,6 @@
 //! `cargo bench -p ocellus-attention`: the saliency pipeline at 640x480 and its hot kernels.
 //! `ocellus bench saliency` prints the figures (median, all cores, per stage, memory).
+#![allow(clippy::expect_used)] // a benchmark aborts on broken set-up
 
 use ocellus_attention::{SaliencyConfig, SaliencyEngine};
 use ocellus_image::convert::RgbImage;

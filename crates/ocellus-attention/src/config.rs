@@ -33,7 +33,7 @@ impl IntensityWeights {
     pub fn weights(self) -> [f32; 3] {
         match self {
             IntensityWeights::Mean => [1.0 / 3.0; 3],
-            IntensityWeights::Luminance => [0.298_936_02, 0.587_043_07, 0.114_020_9],
+            IntensityWeights::Luminance => [0.298_936, 0.587_043, 0.114_021],
         }
     }
 }

@@ -120,9 +120,9 @@ impl Normalizer {
 }
 
 /// Itti et al. 1998: multiply by `(M - mean of local maxima)^2`, M the range's top (or the
-/// map maximum without a range). Local maxima: interior pixels >= their 4 neighbours and
-/// >= a tenth of the range (SaliencyToolbox `maxNormalizeLocalMax`). With one maximum the
-/// factor is `M^2`; with none the map is left as is.
+/// map maximum without a range). Local maxima: interior pixels not below their 4 neighbours
+/// nor below a tenth of the range (SaliencyToolbox `maxNormalizeLocalMax`). With one maximum
+/// the factor is `M^2`; with none the map is left as is.
 fn local_max(map: &mut Plane<f32>, range: Option<f32>) {
     let (thresh, gmax) = match range {
         Some(r) => (r / 10.0, r),

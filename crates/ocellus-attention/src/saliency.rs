@@ -183,8 +183,7 @@ impl SaliencyEngine {
         let normalizer = Normalizer::new(&cfg.normalization, map_size.0, map_size.1, cfg.flat_tolerance)?;
         let features = pairs
             .iter()
-            .enumerate()
-            .flat_map(|(_, p)| (0..subs.len()).map(move |s| (s, *p)))
+            .flat_map(|p| (0..subs.len()).map(move |s| (s, *p)))
             .map(|(s, p)| FeatureMap {
                 subfeature: s,
                 center: p.center,

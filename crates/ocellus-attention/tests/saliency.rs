@@ -1,4 +1,5 @@
 //! Properties of the saliency pipeline against independent references and ground truth.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
 use ocellus_attention::config::{ChannelConfig, ChannelKind, GaborBorder, SaliencyConfig};
 use ocellus_attention::gabor::{kernel_2d, GaborBank};

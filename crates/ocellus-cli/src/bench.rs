@@ -86,7 +86,7 @@ fn bench_preset(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize) -> Result<s
         e.process(f)?;
     }
     let mut total = Vec::with_capacity(n);
-    let mut stages: Vec<Vec<f64>> = vec![Vec::with_capacity(n); 6];
+    let mut stages: Vec<Vec<f64>> = (0..6).map(|_| Vec::with_capacity(n)).collect();
     for f in frames.iter().cycle().take(n) {
         let t = Instant::now();
         e.process(f)?;

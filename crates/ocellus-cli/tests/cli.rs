@@ -1,4 +1,5 @@
 //! The `ocellus` binary as a user runs it.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
 use std::path::PathBuf;
 use std::process::Command;

@@ -1,5 +1,6 @@
 //! Every fast kernel against a slow, direct implementation written here, and every
 //! available backend against the portable one.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
 use ocellus_image::filter::{
     correlate_2d_direct, filter_cols, filter_rows, sep_filter, Border, FilterScratch, PreservingFilter,

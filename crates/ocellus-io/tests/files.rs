@@ -1,4 +1,5 @@
 //! Reading real files, writing maps, and clear errors for bad files.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
 use ocellus_image::convert::RgbImage;
 use ocellus_image::Plane;
