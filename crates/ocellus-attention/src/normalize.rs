@@ -4,7 +4,23 @@
 use crate::config::{GlobalInhibition, Normalization};
 use crate::Result;
 use ocellus_image::filter::PreservingFilter;
-use ocellus_image::{Backend, Plane};
+use ocellus_image::simd::Madd;
+use ocellus_image::{dispatch_kernel, Backend, Plane};
+
+/// One competition step: `M <- max(0, M + E - I - c)`.
+#[inline(always)]
+fn compete_generic<M: Madd>(map: &mut Plane<f32>, excit: &Plane<f32>, inhib: &Plane<f32>, c: f32) {
+    for y in 0..map.height() {
+        let (e, i) = (excit.row(y), inhib.row(y));
+        let m = map.row_mut(y);
+        let n = m.len().min(e.len()).min(i.len());
+        for ((v, &ev), &iv) in m[..n].iter_mut().zip(&e[..n]).zip(&i[..n]) {
+            *v = (*v + ev - iv - c).max(0.0);
+        }
+    }
+}
+
+dispatch_kernel!(fn compete => compete_generic(map: &mut Plane<f32>, excit: &Plane<f32>, inhib: &Plane<f32>, c: f32));
 
 /// 1D Gaussian `peak * exp(-i^2 / (2 sigma^2))` for `i = -hw..=hw`, with `hw` where it falls
 /// below 1 % of the peak: `floor(sigma * sqrt(-2 ln 0.01))` (seed eq. 18), capped at `max_hw`
@@ -106,12 +122,7 @@ impl Normalizer {
                         GlobalInhibition::Constant(c) => c,
                         GlobalInhibition::RelativeToMax(f) => f * map.min_max().1,
                     };
-                    for y in 0..map.height() {
-                        let (e, i) = (self.excit.row(y), self.inhib.row(y));
-                        for (x, v) in map.row_mut(y).iter_mut().enumerate() {
-                            *v = (*v + e[x] - i[x] - c).max(0.0);
-                        }
-                    }
+                    compete(backend, map, &self.excit, &self.inhib, c);
                 }
                 Ok(())
             }

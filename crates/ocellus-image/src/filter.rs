@@ -403,6 +403,7 @@ pub fn correlate_2d_direct(src: &Plane<f32>, k: &[f32], kw: usize, kh: usize, bo
 #[derive(Debug, Clone)]
 pub struct PreservingFilter {
     k: Vec<f32>,
+    sym: Symmetry,
     width: usize,
     height: usize,
     fx: Vec<f32>,
@@ -442,6 +443,7 @@ impl PreservingFilter {
             .collect();
         Ok(Self {
             k: k.to_vec(),
+            sym: symmetry(k),
             width,
             height,
             fx,
@@ -463,7 +465,7 @@ impl PreservingFilter {
             });
         }
         dst.resize(self.width, self.height);
-        preserving_kernel(backend, &self.k, &self.fx, &self.rows, &mut self.padded, &mut self.tmp, src, dst);
+        preserving_kernel(backend, &self.k, self.sym, &self.fx, &self.rows, &mut self.padded, &mut self.tmp, src, dst);
         Ok(())
     }
 }
@@ -471,6 +473,7 @@ impl PreservingFilter {
 #[inline(always)]
 fn preserving_generic<M: Madd>(
     k: &[f32],
+    sym: Symmetry,
     fx: &[f32],
     rows: &[Vec<(usize, f32)>],
     padded: &mut [f32],
@@ -483,7 +486,7 @@ fn preserving_generic<M: Madd>(
     for y in 0..src.height() {
         padded[hw..hw + w].copy_from_slice(src.row(y));
         let out = tmp.row_mut(y);
-        correlate_any_generic::<M>(padded, k, symmetry(k), out);
+        correlate_any_generic::<M>(padded, k, sym, out);
         for (o, f) in out.iter_mut().zip(fx) {
             *o *= f;
         }
@@ -494,5 +497,5 @@ fn preserving_generic<M: Madd>(
 }
 
 dispatch_kernel!(fn preserving_kernel => preserving_generic(
-    k: &[f32], fx: &[f32], rows: &[Vec<(usize, f32)>], padded: &mut [f32], tmp: &mut Plane<f32>, src: &Plane<f32>, dst: &mut Plane<f32>
+    k: &[f32], sym: Symmetry, fx: &[f32], rows: &[Vec<(usize, f32)>], padded: &mut [f32], tmp: &mut Plane<f32>, src: &Plane<f32>, dst: &mut Plane<f32>
 ));
