@@ -8,7 +8,8 @@
 //! Channel values are in [0, 1] for r, g, b, I; RG and BY are in [-1, 1].
 
 use ocellus_image::convert::RgbImage;
-use ocellus_image::{Backend, Plane};
+use ocellus_image::simd::Madd;
+use ocellus_image::{dispatch_kernel, Backend, Plane};
 
 /// Intensity and opponency of one pixel: (I, RG, BY).
 #[inline(always)]
@@ -84,18 +85,19 @@ fn opponent_rows<P: Copy + Default>(
     )
 }
 
-#[cfg(target_arch = "x86_64")]
-mod avx2 {
-    use super::*;
-    #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn split_u8(src: &Plane<[u8; 3]>, out: [&mut Plane<f32>; 3]) {
-        split_rows(src, px_u8, out)
-    }
-    #[target_feature(enable = "avx2,fma")]
-    pub unsafe fn opp_u8(src: &Plane<[u8; 3]>, w: [f32; 3], thr: f32, out: [&mut Plane<f32>; 3]) {
-        opponent_rows(src, px_u8, w, thr, out)
-    }
+#[inline(always)]
+fn split_u8_generic<M: Madd>(src: &Plane<[u8; 3]>, out: [&mut Plane<f32>; 3]) {
+    split_rows(src, px_u8, out)
 }
+
+dispatch_kernel!(fn split_u8 => split_u8_generic(src: &Plane<[u8; 3]>, out: [&mut Plane<f32>; 3]));
+
+#[inline(always)]
+fn opponent_u8_generic<M: Madd>(src: &Plane<[u8; 3]>, w: [f32; 3], thr: f32, out: [&mut Plane<f32>; 3]) {
+    opponent_rows(src, px_u8, w, thr, out)
+}
+
+dispatch_kernel!(fn opponent_u8 => opponent_u8_generic(src: &Plane<[u8; 3]>, w: [f32; 3], thr: f32, out: [&mut Plane<f32>; 3]));
 
 fn resize3(out: &mut [&mut Plane<f32>; 3], w: usize, h: usize) {
     for p in out.iter_mut() {
@@ -108,16 +110,7 @@ pub fn split_rgb(backend: Backend, img: &RgbImage, mut out: [&mut Plane<f32>; 3]
     let (w, h) = img.size();
     resize3(&mut out, w, h);
     match img {
-        RgbImage::U8(p) => {
-            #[cfg(target_arch = "x86_64")]
-            if backend.resolve() == Backend::Avx2 {
-                // SAFETY: Avx2 is resolved only when the CPU supports AVX2 and FMA.
-                unsafe { avx2::split_u8(p, out) };
-                return;
-            }
-            let _ = backend;
-            split_rows(p, px_u8, out)
-        }
+        RgbImage::U8(p) => split_u8(backend, p, out),
         RgbImage::F32(p) => split_rows(p, |v| v, out),
     }
 }
@@ -133,16 +126,7 @@ pub fn opponent_planes(
     let (w, h) = img.size();
     resize3(&mut out, w, h);
     match img {
-        RgbImage::U8(p) => {
-            #[cfg(target_arch = "x86_64")]
-            if backend.resolve() == Backend::Avx2 {
-                // SAFETY: Avx2 is resolved only when the CPU supports AVX2 and FMA.
-                unsafe { avx2::opp_u8(p, weights, threshold, out) };
-                return;
-            }
-            let _ = backend;
-            opponent_rows(p, px_u8, weights, threshold, out)
-        }
+        RgbImage::U8(p) => opponent_u8(backend, p, weights, threshold, out),
         RgbImage::F32(p) => opponent_rows(p, |v| v, weights, threshold, out),
     }
 }

@@ -291,41 +291,8 @@ fn pyr_down_rgb8_generic<M: Madd>(
         s.even3[c].resize(w.div_ceil(2), 0.0);
         s.odd3[c].resize(w / 2, 0.0);
     }
-    const SCALE: f32 = 1.0 / 255.0;
     for j in 0..d0.height() {
-        kernel.taps_for(j, h, &mut s.taps);
-        // Vertical pass on the interleaved bytes, 32 values at a time.
-        let out = &mut s.row3[..];
-        let n = out.len();
-        let mut x = 0;
-        while x + 32 <= n {
-            let mut acc = [0f32; 32];
-            for &(r, wt) in s.taps.iter() {
-                let row: &[u8; 32] = src.row(r).as_flattened()[x..x + 32].try_into().unwrap_or(&[0; 32]);
-                let wt = wt * SCALE;
-                for l in 0..32 {
-                    acc[l] = M::madd(wt, row[l] as f32, acc[l]);
-                }
-            }
-            out[x..x + 32].copy_from_slice(&acc);
-            x += 32;
-        }
-        if x < n && n >= 32 {
-            let x0 = n - 32;
-            let mut acc = [0f32; 32];
-            for &(r, wt) in s.taps.iter() {
-                let row: &[u8; 32] = src.row(r).as_flattened()[x0..x0 + 32].try_into().unwrap_or(&[0; 32]);
-                let wt = wt * SCALE;
-                for l in 0..32 {
-                    acc[l] = M::madd(wt, row[l] as f32, acc[l]);
-                }
-            }
-            out[x0..x0 + 32].copy_from_slice(&acc);
-            x = n;
-        }
-        for (xx, o) in out.iter_mut().enumerate().skip(x) {
-            *o = s.taps.iter().map(|&(r, wt)| wt * SCALE * src.row(r).as_flattened()[xx] as f32).sum();
-        }
+        vertical_bytes::<M>(src, j, h, kernel, &mut s.taps, &mut s.row3);
         // Split into even/odd samples per channel (two RGB pixels = 6 values at a time).
         let [e0, e1, e2] = &mut s.even3;
         let [o0, o1, o2] = &mut s.odd3;
@@ -350,6 +317,50 @@ fn pyr_down_rgb8_generic<M: Madd>(
         for (c, d) in [&mut *d0, &mut *d1, &mut *d2].into_iter().enumerate() {
             decimate_one::<M>(&s.even3[c], &s.odd3[c], w, kernel, &mut s.taps2, d.row_mut(j));
         }
+    }
+}
+
+/// 32 values of `out` at `x` from interleaved byte rows: `sum_taps w * byte / 255`.
+#[inline(always)]
+fn bytes_chunk<M: Madd>(src: &Plane<[u8; 3]>, x: usize, taps: &[(usize, f32)], out: &mut [f32]) {
+    const Z: [u8; 32] = [0; 32];
+    let Ok(out) = <&mut [f32; 32]>::try_from(&mut out[x..x + 32]) else { return };
+    let mut acc = [0f32; 32];
+    for &(r, wt) in taps {
+        let row: &[u8; 32] = src.row(r).as_flattened()[x..x + 32].try_into().unwrap_or(&Z);
+        let wt = wt * (1.0 / 255.0);
+        for l in 0..32 {
+            acc[l] = M::madd(wt, row[l] as f32, acc[l]);
+        }
+    }
+    *out = acc;
+}
+
+/// Vertical low-pass of output row `j` straight from the interleaved bytes into `row3`
+/// (values in [0, 1]), truncated and renormalized at the borders.
+#[inline(always)]
+fn vertical_bytes<M: Madd>(
+    src: &Plane<[u8; 3]>,
+    j: usize,
+    h: usize,
+    kernel: &PyramidKernel,
+    taps: &mut Vec<(usize, f32)>,
+    row3: &mut [f32],
+) {
+    kernel.taps_for(j, h, taps);
+    let n = row3.len();
+    let mut x = 0;
+    while x + 32 <= n {
+        bytes_chunk::<M>(src, x, taps, row3);
+        x += 32;
+    }
+    if x < n && n >= 32 {
+        // One chunk aligned to the end; recomputes a few values.
+        bytes_chunk::<M>(src, n - 32, taps, row3);
+        x = n;
+    }
+    for (xx, o) in row3.iter_mut().enumerate().skip(x) {
+        *o = taps.iter().map(|&(r, wt)| wt * (1.0 / 255.0) * src.row(r).as_flattened()[xx] as f32).sum();
     }
 }
 
