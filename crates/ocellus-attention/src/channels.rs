@@ -86,6 +86,7 @@ fn opponent_rows<P: Copy + Default>(
 }
 
 #[inline(always)]
+#[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
 fn split_u8_generic<M: Madd>(src: &Plane<[u8; 3]>, out: [&mut Plane<f32>; 3]) {
     split_rows(src, px_u8, out)
 }
@@ -93,6 +94,7 @@ fn split_u8_generic<M: Madd>(src: &Plane<[u8; 3]>, out: [&mut Plane<f32>; 3]) {
 dispatch_kernel!(fn split_u8 => split_u8_generic(src: &Plane<[u8; 3]>, out: [&mut Plane<f32>; 3]));
 
 #[inline(always)]
+#[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
 fn opponent_u8_generic<M: Madd>(src: &Plane<[u8; 3]>, w: [f32; 3], thr: f32, out: [&mut Plane<f32>; 3]) {
     opponent_rows(src, px_u8, w, thr, out)
 }

@@ -9,6 +9,7 @@ use ocellus_image::{dispatch_kernel, Backend, Plane};
 
 /// One competition step: `M <- max(0, M + E - I - c)`.
 #[inline(always)]
+#[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
 fn compete_generic<M: Madd>(map: &mut Plane<f32>, excit: &Plane<f32>, inhib: &Plane<f32>, c: f32) {
     for y in 0..map.height() {
         let (e, i) = (excit.row(y), inhib.row(y));
