@@ -12,7 +12,8 @@
 use crate::config::{GaborBorder, GaborConfig};
 use crate::Result;
 use ocellus_image::filter::{filter_cols, filter_rows, sep_filter, Border, FilterScratch};
-use ocellus_image::{Backend, Plane};
+use ocellus_image::simd::Madd;
+use ocellus_image::{dispatch_kernel, Backend, Plane};
 
 /// 1D factors and 2D normalization constants of one orientation.
 #[derive(Clone, Debug)]
@@ -86,7 +87,8 @@ pub struct GaborBank {
     box_: Plane<f32>,
     hr: Plane<f32>,
     hi: Plane<f32>,
-    /// Per angle: [Hr*vr, Hi*vi, Hr*vi, Hi*vr] of the last level (reused by mirror angles).
+    /// Per angle: [Hr*vr, Hi*vi, Hr*vi, Hi*vr] of the last level (mirror angles read their
+    /// original's).
     parts: Vec<[Plane<f32>; 4]>,
 }
 
@@ -172,16 +174,9 @@ impl GaborBank {
         sep_filter(backend, src, &mut self.box_, &self.ones, &self.ones, border, s)?;
         for a in 0..self.angles.len() {
             let f = &self.angles[a];
-            if let Some(m) = f.mirror_of {
-                // theta' = 180 - theta: Hi flips sign, v is shared, so the four parts are reused.
-                let (lo, hi_) = self.parts.split_at_mut(a);
-                for (d, sp) in hi_[0].iter_mut().zip(&lo[m]) {
-                    d.copy_from(sp);
-                }
-                let [_, b, _, d] = &mut self.parts[a];
-                negate(b);
-                negate(d);
-            } else {
+            // theta' = 180 - theta: Hi flips sign and v is shared, so a mirror angle reuses its
+            // original's parts with the signs of B and D flipped (see energy_row).
+            if f.mirror_of.is_none() {
                 filter_rows(backend, src, &mut self.hr, &f.hr, border, s)?;
                 if let Some(hi) = &f.hi {
                     filter_rows(backend, src, &mut self.hi, hi, border, s)?;
@@ -212,22 +207,28 @@ impl GaborBank {
                 }
             }
             let f = &self.angles[a];
-            let p = &self.parts[a];
-            let o = &mut out[a];
+            let (p, sgn) = match f.mirror_of {
+                Some(m) => (&self.parts[m], -1.0),
+                None => (&self.parts[a], 1.0),
+            };
             let (w, h) = src.size();
+            let o = &mut out[a];
             o.resize(w, h);
             let h2 = self.cfg.size / 2;
             let stb = self.cfg.border == GaborBorder::StbCompat && h2 > 0 && h2 <= h;
+            let consts = [f.mean_even, f.inv_norm_even, f.mean_odd, f.inv_norm_odd, sgn];
             for y in 0..h {
-                let (a0, a1, a2, a3, bx) = (p[0].row(y), p[1].row(y), p[2].row(y), p[3].row(y), self.box_.row(y));
-                let orow = o.row_mut(y);
+                let rows = [p[0].row(y), p[1].row(y), p[2].row(y), p[3].row(y), self.box_.row(y)];
                 let (fe, fo) = if stb { stb_row_factors(&self.cfg, f, y, h) } else { (1.0, 1.0) };
-                let (x0, x1) = if stb && (fe, fo) != (1.0, 1.0) { (h2, w.saturating_sub(h2).max(h2)) } else { (w, w) };
-                for x in 0..w {
-                    let even = (a0[x] - a1[x] - f.mean_even * bx[x]) * f.inv_norm_even;
-                    let odd = (a2[x] + a3[x] - f.mean_odd * bx[x]) * f.inv_norm_odd;
-                    orow[x] =
-                        if x >= x0 && x < x1 { (even * fe).abs() + (odd * fo).abs() } else { even.abs() + odd.abs() };
+                let orow = o.row_mut(y);
+                if (fe, fo) == (1.0, 1.0) {
+                    energy_row(backend, rows, consts, [1.0, 1.0], orow);
+                } else {
+                    // The toolbox's factors apply to the interior columns only.
+                    let (x0, x1) = (h2.min(w), w.saturating_sub(h2).max(h2.min(w)));
+                    energy_row(backend, rows.map(|v| &v[..x0]), consts, [1.0, 1.0], &mut orow[..x0]);
+                    energy_row(backend, rows.map(|v| &v[x0..x1]), consts, [fe, fo], &mut orow[x0..x1]);
+                    energy_row(backend, rows.map(|v| &v[x1..]), consts, [1.0, 1.0], &mut orow[x1..]);
                 }
             }
         }
@@ -235,11 +236,22 @@ impl GaborBank {
     }
 }
 
-fn negate(p: &mut Plane<f32>) {
-    for y in 0..p.height() {
-        p.row_mut(y).iter_mut().for_each(|v| *v = -*v);
+/// Gabor energy of one row: `|fe (Re - m_e B) / n_e| + |fo (Im - m_o B) / n_o|` with
+/// `Re = p0 - s p1`, `Im = p2 + s p3`, B the box sum; `c = [m_e, 1/n_e, m_o, 1/n_o, s]`
+/// (s = -1 for the mirror angle 180 - theta, whose Hi factor has the opposite sign).
+#[inline(always)]
+fn energy_row_generic<M: Madd>(r: [&[f32]; 5], c: [f32; 5], f: [f32; 2], out: &mut [f32]) {
+    let n = out.len();
+    let [a0, a1, a2, a3, bx] = r.map(|v| &v[..n]);
+    let (se, so, sgn) = (c[1] * f[0], c[3] * f[1], c[4]);
+    for x in 0..n {
+        let even = M::madd(-c[0], bx[x], M::madd(-sgn, a1[x], a0[x])) * se;
+        let odd = M::madd(-c[2], bx[x], M::madd(sgn, a3[x], a2[x])) * so;
+        out[x] = even.abs() + odd.abs();
     }
 }
+
+dispatch_kernel!(fn energy_row => energy_row_generic(r: [&[f32]; 5], c: [f32; 5], f: [f32; 2], out: &mut [f32]));
 
 fn zero_like(p: &mut Plane<f32>, like: &Plane<f32>) {
     p.resize(like.width(), like.height());
