@@ -3,7 +3,7 @@
 
 use crate::config::{GlobalInhibition, Normalization};
 use crate::Result;
-use ocellus_image::filter::PreservingFilter;
+use ocellus_image::filter::{Lanes, PreservingFilter};
 use ocellus_image::simd::Madd;
 use ocellus_image::{dispatch_kernel, Backend, Plane};
 
@@ -65,6 +65,9 @@ pub struct Normalizer {
     excit: Plane<f32>,
     inhib: Plane<f32>,
     flat_tolerance: f32,
+    excit_lanes: Plane<Lanes>,
+    inhib_lanes: Plane<Lanes>,
+    one: Plane<f32>,
 }
 
 impl Normalizer {
@@ -96,6 +99,9 @@ impl Normalizer {
             excit: Plane::new(width, height),
             inhib: Plane::new(width, height),
             flat_tolerance,
+            excit_lanes: Plane::new(width, height),
+            inhib_lanes: Plane::new(width, height),
+            one: Plane::new(width, height),
         })
     }
 
@@ -130,6 +136,98 @@ impl Normalizer {
         }
     }
 }
+
+impl Normalizer {
+    /// [`apply`](Self::apply) on eight interleaved maps at once; each lane gets exactly the
+    /// treatment of `apply` (its own range scaling and global inhibition).
+    pub fn apply_lanes(&mut self, backend: Backend, maps: &mut Plane<Lanes>, range: Option<f32>) -> Result<()> {
+        let Normalization::Iterative { iterations, global_inhibition, .. } = self.kind.clone() else {
+            // The other rules are cheap: one lane at a time.
+            for l in 0..8 {
+                self.one.resize(maps.width(), maps.height());
+                for y in 0..maps.height() {
+                    let (src, dst) = (maps.row(y), self.one.row_mut(y));
+                    dst.iter_mut().zip(src).for_each(|(d, s)| *d = s[l]);
+                }
+                let mut one = std::mem::take(&mut self.one);
+                let r = self.apply(backend, &mut one, range);
+                for y in 0..maps.height() {
+                    maps.row_mut(y).iter_mut().zip(one.row(y)).for_each(|(d, s)| d[l] = *s);
+                }
+                self.one = one;
+                r?;
+            }
+            return Ok(());
+        };
+        let (mut mn, mut mx) = lanes_min_max(maps);
+        if let Some(r) = range {
+            // Clamp at 0, then scale each lane to [0, r] (flat lanes to r / 2).
+            mn = mn.map(|v| v.max(0.0));
+            mx = mx.map(|v| v.max(0.0));
+            let flat: [bool; 8] = std::array::from_fn(|l| mx[l] - mn[l] <= self.flat_tolerance);
+            let scale: Lanes = std::array::from_fn(|l| if flat[l] { 0.0 } else { r / (mx[l] - mn[l]) });
+            let offset: Lanes = std::array::from_fn(|l| if flat[l] { 0.5 * r } else { -mn[l] * scale[l] });
+            lanes_affine(backend, maps, scale, offset);
+        } else {
+            lanes_affine(backend, maps, [1.0; 8], [0.0; 8]);
+        }
+        let (Some(ex), Some(inh)) = (self.excitation.as_mut(), self.inhibition.as_mut()) else { return Ok(()) };
+        for _ in 0..iterations {
+            ex.apply_lanes(backend, maps, &mut self.excit_lanes)?;
+            inh.apply_lanes(backend, maps, &mut self.inhib_lanes)?;
+            let c: Lanes = match global_inhibition {
+                GlobalInhibition::Constant(c) => [c; 8],
+                GlobalInhibition::RelativeToMax(f) => lanes_min_max(maps).1.map(|m| f * m),
+            };
+            compete_lanes(backend, maps, &self.excit_lanes, &self.inhib_lanes, c);
+        }
+        Ok(())
+    }
+}
+
+/// Per-lane (min, max).
+fn lanes_min_max(maps: &Plane<Lanes>) -> (Lanes, Lanes) {
+    let (mut mn, mut mx) = ([f32::INFINITY; 8], [f32::NEG_INFINITY; 8]);
+    for r in maps.rows() {
+        for p in r {
+            for l in 0..8 {
+                mn[l] = mn[l].min(p[l]);
+                mx[l] = mx[l].max(p[l]);
+            }
+        }
+    }
+    (mn, mx)
+}
+
+/// `v <- max(0, v) * scale + offset` per lane.
+#[inline(always)]
+fn lanes_affine_generic<M: Madd>(maps: &mut Plane<Lanes>, scale: Lanes, offset: Lanes) {
+    for y in 0..maps.height() {
+        for p in maps.row_mut(y) {
+            for l in 0..8 {
+                p[l] = M::madd(p[l].max(0.0), scale[l], offset[l]);
+            }
+        }
+    }
+}
+
+dispatch_kernel!(fn lanes_affine => lanes_affine_generic(maps: &mut Plane<Lanes>, scale: Lanes, offset: Lanes));
+
+/// One competition step per lane: `M <- max(0, M + E - I - c)`.
+#[inline(always)]
+#[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
+fn compete_lanes_generic<M: Madd>(maps: &mut Plane<Lanes>, excit: &Plane<Lanes>, inhib: &Plane<Lanes>, c: Lanes) {
+    for y in 0..maps.height() {
+        let (e, i) = (excit.row(y), inhib.row(y));
+        for ((p, ev), iv) in maps.row_mut(y).iter_mut().zip(e).zip(i) {
+            for l in 0..8 {
+                p[l] = (p[l] + ev[l] - iv[l] - c[l]).max(0.0);
+            }
+        }
+    }
+}
+
+dispatch_kernel!(fn compete_lanes => compete_lanes_generic(maps: &mut Plane<Lanes>, excit: &Plane<Lanes>, inhib: &Plane<Lanes>, c: Lanes));
 
 /// Itti et al. 1998: multiply by `(M - mean of local maxima)^2`, M the range's top (or the
 /// map maximum without a range). Local maxima: interior pixels not below their 4 neighbours

@@ -10,6 +10,7 @@ use crate::gabor::GaborBank;
 use crate::normalize::Normalizer;
 use crate::{AttentionError, Result};
 use ocellus_image::convert::RgbImage;
+use ocellus_image::filter::Lanes;
 use ocellus_image::pyramid::{level_sizes, pyr_down, pyr_down_rgb8, PyrScratch};
 use ocellus_image::resample::{ResampleMethod, Resampler};
 use ocellus_image::{Backend, Plane};
@@ -117,8 +118,8 @@ pub struct SaliencyEngine {
     rescaled: Vec<Vec<Plane<f32>>>,
     features: Vec<FeatureMap>,
     normalizer: Normalizer,
-    tmp: Plane<f32>,
-    sub_sum: Plane<f32>,
+    lanes: Plane<Lanes>,
+    sub_sums: Vec<Plane<f32>>,
     conspicuity: Vec<Plane<f32>>,
     saliency: Plane<f32>,
     prior: Option<Plane<f32>>,
@@ -211,8 +212,8 @@ impl SaliencyEngine {
             rescaled: (0..subs.len()).map(|_| empty_pyr(n)).collect(),
             features,
             normalizer,
-            tmp: Plane::new(map_size.0, map_size.1),
-            sub_sum: Plane::new(map_size.0, map_size.1),
+            lanes: Plane::new(map_size.0, map_size.1),
+            sub_sums: (0..subs.len()).map(|_| Plane::new(map_size.0, map_size.1)).collect(),
             conspicuity: (0..cfg.channels.len()).map(|_| Plane::new(map_size.0, map_size.1)).collect(),
             saliency: Plane::new(map_size.0, map_size.1),
             prior: None,
@@ -466,32 +467,45 @@ impl SaliencyEngine {
 
     fn normalize_and_combine(&mut self) -> Result<(Duration, Duration)> {
         let b = self.backend;
-        let mut t_norm = Duration::ZERO;
         let t_start = Instant::now();
         let n_channels = self.cfg.channels.len();
         let range = self.cfg.feature_range;
+        // Feature maps: N with rescaling, eight at a time, summed per sub-feature.
+        for s in self.sub_sums.iter_mut() {
+            s.fill(0.0);
+        }
+        let t = Instant::now();
+        // Eight maps per batch, one per SIMD lane (see Normalizer::apply_lanes).
+        let nf = self.features.len();
+        for start in (0..nf).step_by(8) {
+            let maps: [Option<&Plane<f32>>; 8] = std::array::from_fn(|l| self.features.get(start + l).map(|f| &f.map));
+            interleave(&maps, &mut self.lanes);
+            self.normalizer.apply_lanes(b, &mut self.lanes, Some(range))?;
+            for (l, f) in self.features[start..nf.min(start + 8)].iter().enumerate() {
+                add_lane(&mut self.sub_sums[f.subfeature], &self.lanes, l);
+            }
+        }
+        // Sub-feature sums: N without rescaling, in place.
+        let ns = self.sub_sums.len();
+        for start in (0..ns).step_by(8) {
+            let maps: [Option<&Plane<f32>>; 8] = std::array::from_fn(|l| self.sub_sums.get(start + l));
+            interleave(&maps, &mut self.lanes);
+            self.normalizer.apply_lanes(b, &mut self.lanes, None)?;
+            for (l, m) in self.sub_sums[start..ns.min(start + 8)].iter_mut().enumerate() {
+                copy_lane(m, &self.lanes, l);
+            }
+        }
+        let mut t_norm = t.elapsed();
         let weight_sum: f32 = self.cfg.channels.iter().map(|c| c.weight).sum();
         for ci in 0..n_channels {
             let cm = &mut self.conspicuity[ci];
             cm.fill(0.0);
             let mut n_sub = 0usize;
-            for s in 0..self.subs.len() {
-                if self.subs[s].channel != ci {
-                    continue;
+            for (s, sub) in self.subs.iter().enumerate() {
+                if sub.channel == ci {
+                    n_sub += 1;
+                    add_into(cm, &self.sub_sums[s]);
                 }
-                n_sub += 1;
-                self.sub_sum.fill(0.0);
-                for f in self.features.iter().filter(|f| f.subfeature == s) {
-                    self.tmp.copy_from(&f.map);
-                    let t = Instant::now();
-                    self.normalizer.apply(b, &mut self.tmp, Some(range))?;
-                    t_norm += t.elapsed();
-                    add_into(&mut self.sub_sum, &self.tmp);
-                }
-                let t = Instant::now();
-                self.normalizer.apply(b, &mut self.sub_sum, None)?;
-                t_norm += t.elapsed();
-                add_into(cm, &self.sub_sum);
             }
             if n_sub > 1 {
                 let t = Instant::now();
@@ -571,6 +585,34 @@ impl SaliencyEngine {
         };
         up.apply(&self.saliency, out)?;
         Ok(())
+    }
+}
+
+/// Packs up to eight same-size maps into the lanes of `lanes` (missing maps give zeros).
+fn interleave(maps: &[Option<&Plane<f32>>; 8], lanes: &mut Plane<Lanes>) {
+    let Some(first) = maps[0] else { return };
+    lanes.resize(first.width(), first.height());
+    for y in 0..first.height() {
+        let rows: [Option<&[f32]>; 8] = maps.map(|m| m.map(|p| p.row(y)));
+        for (x, px) in lanes.row_mut(y).iter_mut().enumerate() {
+            *px = rows.map(|r| r.map_or(0.0, |r| r[x]));
+        }
+    }
+}
+
+/// `acc += lane l of lanes`.
+fn add_lane(acc: &mut Plane<f32>, lanes: &Plane<Lanes>, l: usize) {
+    for y in 0..acc.height() {
+        let src = lanes.row(y);
+        acc.row_mut(y).iter_mut().zip(src).for_each(|(a, p)| *a += p[l]);
+    }
+}
+
+/// `dst = lane l of lanes`.
+fn copy_lane(dst: &mut Plane<f32>, lanes: &Plane<Lanes>, l: usize) {
+    for y in 0..dst.height() {
+        let src = lanes.row(y);
+        dst.row_mut(y).iter_mut().zip(src).for_each(|(a, p)| *a = p[l]);
     }
 }
 

@@ -281,3 +281,24 @@ proptest! {
         prop_assert_eq!(r.is_ok(), n >= w * h);
     }
 }
+
+#[test]
+fn preserving_filter_on_lanes_equals_one_map_at_a_time() {
+    let g: Vec<f32> = (-14i32..=14).map(|i| (-(i * i) as f32 / 200.0).exp()).collect();
+    for (w, h) in [(40, 30), (37, 25), (3, 2)] {
+        let maps: Vec<Plane<f32>> = (0..8).map(|m| noise(w, h, 100 + m)).collect();
+        let lanes = Plane::from_fn(w, h, |x, y| std::array::from_fn(|l| maps[l].get(x, y)));
+        for b in Backend::available() {
+            let mut f = PreservingFilter::new(&g, w, h).unwrap();
+            let mut out = Plane::default();
+            f.apply_lanes(b, &lanes, &mut out).unwrap();
+            for (l, m) in maps.iter().enumerate() {
+                let mut one = Plane::default();
+                f.apply(b, m, &mut one).unwrap();
+                let lane = out.map(|p| p[l]);
+                let rel = max_abs_diff(&lane, &one) / one.min_max().1;
+                assert!(rel < 1e-5, "{w}x{h} lane {l} {b:?}: relative difference {rel:e}");
+            }
+        }
+    }
+}
