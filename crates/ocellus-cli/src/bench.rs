@@ -5,7 +5,6 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use ocellus_attention::{SaliencyConfig, SaliencyEngine};
 use ocellus_image::{convert::RgbImage, Backend, Plane};
-use rayon::prelude::*;
 use serde_json::json;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -95,41 +94,69 @@ fn bench_preset(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize) -> Result<s
             stages[k].push(d.as_secs_f64() * 1e3);
         }
     }
+    let mean_ms = total.iter().sum::<f64>() / total.len() as f64;
     let ms = median(&mut total);
     let names = e.timings().stages().map(|s| s.0);
     let stage_ms: serde_json::Map<String, serde_json::Value> =
         names.iter().zip(stages.iter_mut()).map(|(n, v)| (n.to_string(), json!(median(v)))).collect();
 
-    // All cores: one engine per worker thread, frames spread over the workers.
+    // Throughput with 1 thread and with all threads, same harness, alternated three times
+    // so that both see the same machine load; medians.
     let threads = rayon::current_num_threads();
-    let n_par = n.max(threads * 50);
-    let t = Instant::now();
-    (0..n_par)
-        .into_par_iter()
-        .map_init(
-            || SaliencyEngine::new(cfg.clone(), w, h),
-            |eng, i| -> Result<()> {
-                match eng {
-                    Ok(e) => {
-                        e.process(&frames[i % frames.len()])?;
-                        Ok(())
-                    }
-                    Err(err) => bail!("{err}"),
-                }
-            },
-        )
-        .collect::<Result<Vec<()>>>()?;
-    let par: Duration = t.elapsed();
-    let fps_all = n_par as f64 / par.as_secs_f64();
-    let fps_1 = 1e3 / ms;
+    let (mut one, mut all) = (Vec::new(), Vec::new());
+    for _ in 0..3 {
+        one.push(throughput(cfg, frames, 1, n)?);
+        all.push(throughput(cfg, frames, threads, n.max(threads * 100))?);
+    }
+    let (fps_1, fps_all) = (median(&mut one), median(&mut all));
     Ok(json!({
         "ms_per_frame_1thread": ms,
+        "ms_per_frame_1thread_mean": mean_ms,
         "fps_1thread": fps_1,
+        "threads": threads,
         "fps_all_threads": fps_all,
         "speedup_all_threads": fps_all / fps_1,
         "stage_ms_1thread": stage_ms,
         "frames_timed": n,
     }))
+}
+
+/// Frames per second of `threads` engines (one per thread, built and warmed up before the
+/// clock starts) sharing `n` frames: thread t takes frames t, t + T, ..., as a pipeline that
+/// spreads frames over workers would.
+fn throughput(cfg: &SaliencyConfig, frames: &[RgbImage], threads: usize, n: usize) -> Result<f64> {
+    let (w, h) = frames[0].size();
+    let barrier = std::sync::Barrier::new(threads + 1);
+    let elapsed = std::thread::scope(|scope| -> Result<Duration> {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                let barrier = &barrier;
+                scope.spawn(move || -> Result<()> {
+                    let engine = SaliencyEngine::new(cfg.clone(), w, h);
+                    let warm = engine.and_then(|mut e| {
+                        for f in frames.iter().cycle().take(10) {
+                            e.process(f)?;
+                        }
+                        Ok(e)
+                    });
+                    // Reach the barrier whatever happened, so the timer thread never waits forever.
+                    barrier.wait();
+                    let mut e = warm?;
+                    for i in (t..n).step_by(threads) {
+                        e.process(&frames[i % frames.len()])?;
+                    }
+                    Ok(())
+                })
+            })
+            .collect();
+        barrier.wait();
+        let t0 = Instant::now();
+        for h in handles {
+            h.join().map_err(|_| anyhow::anyhow!("benchmark thread panicked"))??;
+        }
+        Ok(t0.elapsed())
+    })?;
+    Ok(n as f64 / elapsed.as_secs_f64())
 }
 
 /// Runs the subcommand.
