@@ -4,7 +4,7 @@
 
 use ocellus_attention::{SaliencyConfig, SaliencyEngine};
 use ocellus_image::convert::RgbImage;
-use ocellus_image::filter::PreservingFilter;
+use ocellus_image::preserving::PreservingFilter;
 use ocellus_image::pyramid::{pyr_down_rgb8, PyrScratch, PyramidKernel};
 use ocellus_image::{Backend, Plane};
 

@@ -22,6 +22,7 @@
 
 pub mod center_surround;
 pub mod channels;
+pub mod combine;
 pub mod config;
 pub mod gabor;
 pub mod normalize;

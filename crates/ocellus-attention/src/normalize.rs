@@ -3,7 +3,7 @@
 
 use crate::config::{GlobalInhibition, Normalization};
 use crate::Result;
-use ocellus_image::filter::{Lanes, PreservingFilter};
+use ocellus_image::preserving::{Lanes, PreservingFilter};
 use ocellus_image::simd::Madd;
 use ocellus_image::{dispatch_kernel, Backend, Plane};
 

@@ -5,12 +5,13 @@
 
 use crate::center_surround::{abs_difference, attenuate_borders, ramp_width, scale_pairs, ScalePair};
 use crate::channels::{opponent_from_planes, opponent_planes, skin_plane, split_rgb};
+use crate::combine::{add_into, add_lane, copy_lane, interleave, scale};
 use crate::config::{ChannelKind, Combination, OpponencyStage, SaliencyConfig};
 use crate::gabor::GaborBank;
 use crate::normalize::Normalizer;
 use crate::{AttentionError, Result};
 use ocellus_image::convert::RgbImage;
-use ocellus_image::filter::Lanes;
+use ocellus_image::preserving::Lanes;
 use ocellus_image::pyramid::{level_sizes, pyr_down, pyr_down_rgb8, PyrScratch};
 use ocellus_image::resample::{ResampleMethod, Resampler};
 use ocellus_image::{Backend, Plane};
@@ -585,46 +586,5 @@ impl SaliencyEngine {
         };
         up.apply(&self.saliency, out)?;
         Ok(())
-    }
-}
-
-/// Packs up to eight same-size maps into the lanes of `lanes` (missing maps give zeros).
-fn interleave(maps: &[Option<&Plane<f32>>; 8], lanes: &mut Plane<Lanes>) {
-    let Some(first) = maps[0] else { return };
-    lanes.resize(first.width(), first.height());
-    for y in 0..first.height() {
-        let rows: [Option<&[f32]>; 8] = maps.map(|m| m.map(|p| p.row(y)));
-        for (x, px) in lanes.row_mut(y).iter_mut().enumerate() {
-            *px = rows.map(|r| r.map_or(0.0, |r| r[x]));
-        }
-    }
-}
-
-/// `acc += lane l of lanes`.
-fn add_lane(acc: &mut Plane<f32>, lanes: &Plane<Lanes>, l: usize) {
-    for y in 0..acc.height() {
-        let src = lanes.row(y);
-        acc.row_mut(y).iter_mut().zip(src).for_each(|(a, p)| *a += p[l]);
-    }
-}
-
-/// `dst = lane l of lanes`.
-fn copy_lane(dst: &mut Plane<f32>, lanes: &Plane<Lanes>, l: usize) {
-    for y in 0..dst.height() {
-        let src = lanes.row(y);
-        dst.row_mut(y).iter_mut().zip(src).for_each(|(a, p)| *a = p[l]);
-    }
-}
-
-fn add_into(acc: &mut Plane<f32>, x: &Plane<f32>) {
-    for y in 0..acc.height() {
-        let xr = x.row(y);
-        acc.row_mut(y).iter_mut().zip(xr).for_each(|(a, b)| *a += b);
-    }
-}
-
-fn scale(p: &mut Plane<f32>, f: f32) {
-    for y in 0..p.height() {
-        p.row_mut(y).iter_mut().for_each(|v| *v *= f);
     }
 }

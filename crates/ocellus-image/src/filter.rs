@@ -235,7 +235,7 @@ fn correlate_folded_generic<M: Madd>(p: &[f32], k: &[f32], odd: bool, out: &mut 
 
 /// Any kernel on a padded row, folded when it is even or odd.
 #[inline(always)]
-fn correlate_any_generic<M: Madd>(p: &[f32], k: &[f32], sym: Symmetry, out: &mut [f32]) {
+pub(crate) fn correlate_any_generic<M: Madd>(p: &[f32], k: &[f32], sym: Symmetry, out: &mut [f32]) {
     match sym {
         Symmetry::Even => correlate_folded_generic::<M>(p, k, false, out),
         Symmetry::Odd => correlate_folded_generic::<M>(p, k, true, out),
@@ -243,7 +243,7 @@ fn correlate_any_generic<M: Madd>(p: &[f32], k: &[f32], sym: Symmetry, out: &mut
     }
 }
 
-fn check_kernel(k: &[f32], what: &str) -> Result<()> {
+pub(crate) fn check_kernel(k: &[f32], what: &str) -> Result<()> {
     if k.is_empty() || k.len() % 2 == 0 {
         return Err(ImageError::InvalidParameter(format!(
             "{what} kernel has {} taps: a centred kernel needs an odd number",
@@ -270,7 +270,7 @@ fn pad_row(row: &[f32], hw: usize, border: Border, p: &mut Vec<f32>) {
 }
 
 /// Row list for output row `y` of a vertical pass with kernel `k` (centred).
-fn vertical_taps(y: usize, h: usize, k: &[f32], border: Border, rows: &mut Vec<(usize, f32)>) {
+pub(crate) fn vertical_taps(y: usize, h: usize, k: &[f32], border: Border, rows: &mut Vec<(usize, f32)>) {
     let hw = (k.len() - 1) / 2;
     rows.clear();
     for (t, &kt) in k.iter().enumerate() {
@@ -393,229 +393,3 @@ pub fn correlate_2d_direct(src: &Plane<f32>, k: &[f32], kw: usize, kh: usize, bo
         acc as f32
     })
 }
-
-/// Separable correlation with a zero border whose result at each pixel is rescaled by
-/// `sum(kernel) / sum(kernel taps inside the image)`, per axis: the kernel is truncated
-/// at the border and renormalized, so a border does not lower the response
-/// (Walther & Koch 2006, `sepConv2PreserveEnergy`).
-///
-/// Built once for a map size; [`PreservingFilter::apply`] allocates nothing.
-#[derive(Debug, Clone)]
-pub struct PreservingFilter {
-    k: Vec<f32>,
-    sym: Symmetry,
-    width: usize,
-    height: usize,
-    fx: Vec<f32>,
-    rows: Vec<Vec<(usize, f32)>>,
-    padded: Vec<f32>,
-    tmp: Plane<f32>,
-    padded_lanes: Vec<Lanes>,
-    tmp_lanes: Plane<Lanes>,
-}
-
-/// Eight maps interleaved: pixel (x, y) holds the value at (x, y) of each of eight maps, so
-/// one 256-bit operation processes one pixel of all of them.
-pub type Lanes = [f32; 8];
-
-impl PreservingFilter {
-    /// The same 1D kernel `k` (odd length, positive sum) on both axes of a `width` x `height` map.
-    pub fn new(k: &[f32], width: usize, height: usize) -> Result<Self> {
-        check_kernel(k, "energy-preserving")?;
-        let total: f32 = k.iter().sum();
-        if total <= 0.0 {
-            return Err(ImageError::InvalidParameter("energy-preserving kernel must have a positive sum".into()));
-        }
-        let hw = (k.len() - 1) / 2;
-        let valid_sum = |i: usize, n: usize| -> f32 {
-            k.iter()
-                .enumerate()
-                .filter(|(t, _)| {
-                    let p = i as isize + *t as isize - hw as isize;
-                    p >= 0 && p < n as isize
-                })
-                .map(|(_, &v)| v)
-                .sum()
-        };
-        let fx = (0..width).map(|x| total / valid_sum(x, width)).collect();
-        let rows = (0..height)
-            .map(|y| {
-                let f = total / valid_sum(y, height);
-                let mut r = Vec::new();
-                vertical_taps(y, height, k, Border::Zero, &mut r);
-                r.iter_mut().for_each(|(_, w)| *w *= f);
-                r
-            })
-            .collect();
-        Ok(Self {
-            k: k.to_vec(),
-            sym: symmetry(k),
-            width,
-            height,
-            fx,
-            rows,
-            padded: vec![0.0; width + 2 * hw],
-            tmp: Plane::new(width, height),
-            padded_lanes: vec![[0.0; 8]; width + 2 * hw],
-            tmp_lanes: Plane::new(width, height),
-        })
-    }
-
-    /// Filters `src` (which must be `width` x `height`) into `dst`.
-    pub fn apply(&mut self, backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>) -> Result<()> {
-        if src.size() != (self.width, self.height) {
-            return Err(ImageError::SizeMismatch {
-                what: "map",
-                got_w: src.width(),
-                got_h: src.height(),
-                want_w: self.width,
-                want_h: self.height,
-            });
-        }
-        dst.resize(self.width, self.height);
-        preserving_kernel(backend, &self.k, self.sym, &self.fx, &self.rows, &mut self.padded, &mut self.tmp, src, dst);
-        Ok(())
-    }
-}
-
-impl PreservingFilter {
-    /// [`apply`](Self::apply) on eight interleaved maps at once (same result per lane).
-    pub fn apply_lanes(&mut self, backend: Backend, src: &Plane<Lanes>, dst: &mut Plane<Lanes>) -> Result<()> {
-        if src.size() != (self.width, self.height) {
-            return Err(ImageError::SizeMismatch {
-                what: "maps",
-                got_w: src.width(),
-                got_h: src.height(),
-                want_w: self.width,
-                want_h: self.height,
-            });
-        }
-        dst.resize(self.width, self.height);
-        preserving_lanes_kernel(
-            backend,
-            &self.k,
-            &self.fx,
-            &self.rows,
-            &mut self.padded_lanes,
-            &mut self.tmp_lanes,
-            src,
-            dst,
-        );
-        Ok(())
-    }
-}
-
-/// `B` pixels of eight lanes: `sum_i w(i) * s(i)[j]` for j in 0..B.
-#[inline(always)]
-fn lanes_block<'a, M: Madd, const B: usize>(
-    n: usize,
-    w: impl Fn(usize) -> f32,
-    s: impl Fn(usize) -> &'a [Lanes; B],
-) -> [Lanes; B] {
-    let mut acc = [[0f32; 8]; B];
-    for i in 0..n {
-        let (wi, si) = (w(i), s(i));
-        for j in 0..B {
-            for l in 0..8 {
-                acc[j][l] = M::madd(wi, si[j][l], acc[j][l]);
-            }
-        }
-    }
-    acc
-}
-
-#[inline(always)]
-fn preserving_lanes_generic<M: Madd>(
-    k: &[f32],
-    fx: &[f32],
-    rows: &[Vec<(usize, f32)>],
-    padded: &mut [Lanes],
-    tmp: &mut Plane<Lanes>,
-    src: &Plane<Lanes>,
-    dst: &mut Plane<Lanes>,
-) {
-    const Z: [Lanes; 8] = [[0.0; 8]; 8];
-    let hw = (k.len() - 1) / 2;
-    let (w, h) = src.size();
-    tmp.resize(w, h);
-    for y in 0..h {
-        // The ends of `padded` stay zero: only the middle is ever written.
-        padded[hw..hw + w].copy_from_slice(src.row(y));
-        let out = tmp.row_mut(y);
-        let mut x = 0;
-        while x < w && w >= 8 {
-            let x0 = if x + 8 <= w { x } else { w - 8 };
-            let acc = lanes_block::<M, 8>(k.len(), |t| k[t], |t| padded[x0 + t..x0 + t + 8].try_into().unwrap_or(&Z));
-            for j in 0..8 {
-                let f = fx[x0 + j];
-                out[x0 + j] = acc[j].map(|v| v * f);
-            }
-            x = x0 + 8;
-        }
-        while x < w {
-            let mut a = [0f32; 8];
-            for (t, &kt) in k.iter().enumerate() {
-                for l in 0..8 {
-                    a[l] = M::madd(kt, padded[x + t][l], a[l]);
-                }
-            }
-            out[x] = a.map(|v| v * fx[x]);
-            x += 1;
-        }
-    }
-    for (y, r) in rows.iter().enumerate() {
-        let out = dst.row_mut(y);
-        let mut x = 0;
-        while x < w && w >= 8 {
-            let x0 = if x + 8 <= w { x } else { w - 8 };
-            let acc =
-                lanes_block::<M, 8>(r.len(), |i| r[i].1, |i| tmp.row(r[i].0)[x0..x0 + 8].try_into().unwrap_or(&Z));
-            out[x0..x0 + 8].copy_from_slice(&acc);
-            x = x0 + 8;
-        }
-        while x < w {
-            let mut a = [0f32; 8];
-            for &(ry, wt) in r {
-                for l in 0..8 {
-                    a[l] = M::madd(wt, tmp.row(ry)[x][l], a[l]);
-                }
-            }
-            out[x] = a;
-            x += 1;
-        }
-    }
-}
-
-dispatch_kernel!(fn preserving_lanes_kernel => preserving_lanes_generic(
-    k: &[f32], fx: &[f32], rows: &[Vec<(usize, f32)>], padded: &mut [Lanes], tmp: &mut Plane<Lanes>, src: &Plane<Lanes>, dst: &mut Plane<Lanes>
-));
-
-#[inline(always)]
-fn preserving_generic<M: Madd>(
-    k: &[f32],
-    sym: Symmetry,
-    fx: &[f32],
-    rows: &[Vec<(usize, f32)>],
-    padded: &mut [f32],
-    tmp: &mut Plane<f32>,
-    src: &Plane<f32>,
-    dst: &mut Plane<f32>,
-) {
-    let hw = (k.len() - 1) / 2;
-    let w = src.width();
-    for y in 0..src.height() {
-        padded[hw..hw + w].copy_from_slice(src.row(y));
-        let out = tmp.row_mut(y);
-        correlate_any_generic::<M>(padded, k, sym, out);
-        for (o, f) in out.iter_mut().zip(fx) {
-            *o *= f;
-        }
-    }
-    for (y, r) in rows.iter().enumerate() {
-        accumulate_rows_generic::<M>(tmp, r, dst.row_mut(y));
-    }
-}
-
-dispatch_kernel!(fn preserving_kernel => preserving_generic(
-    k: &[f32], sym: Symmetry, fx: &[f32], rows: &[Vec<(usize, f32)>], padded: &mut [f32], tmp: &mut Plane<f32>, src: &Plane<f32>, dst: &mut Plane<f32>
-));

@@ -19,6 +19,7 @@ pub mod convert;
 mod error;
 pub mod filter;
 mod plane;
+pub mod preserving;
 pub mod pyramid;
 pub mod resample;
 pub mod simd;

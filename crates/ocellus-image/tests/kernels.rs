@@ -2,9 +2,8 @@
 //! available backend against the portable one.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
-use ocellus_image::filter::{
-    correlate_2d_direct, filter_cols, filter_rows, sep_filter, Border, FilterScratch, PreservingFilter,
-};
+use ocellus_image::filter::{correlate_2d_direct, filter_cols, filter_rows, sep_filter, Border, FilterScratch};
+use ocellus_image::preserving::PreservingFilter;
 use ocellus_image::pyramid::{level_sizes, pyr_down, pyr_down_rgb8, PyrScratch, PyramidKernel};
 use ocellus_image::resample::{resize, ResampleMethod};
 use ocellus_image::{Backend, Plane};
