@@ -199,6 +199,16 @@ fn decimate_one<M: Madd>(
     }
 }
 
+/// A next level exists only for images of at least 2x2.
+fn check_decimable(w: usize, h: usize) -> Result<()> {
+    if w < 2 || h < 2 {
+        return Err(ImageError::InvalidParameter(format!(
+            "cannot decimate a {w}x{h} image: both sides must be at least 2"
+        )));
+    }
+    Ok(())
+}
+
 /// One pyramid level: `dst` becomes the low-passed, decimated `src` (`floor(w/2)` x `floor(h/2)`).
 ///
 /// Errors if `src` is smaller than 2x2 (no next level exists).
@@ -210,11 +220,7 @@ pub fn pyr_down(
     s: &mut PyrScratch,
 ) -> Result<()> {
     let (w, h) = src.size();
-    if w < 2 || h < 2 {
-        return Err(ImageError::InvalidParameter(format!(
-            "cannot decimate a {w}x{h} image: both sides must be at least 2"
-        )));
-    }
+    check_decimable(w, h)?;
     pyr_down_kernel(backend, src, dst, kernel, s);
     Ok(())
 }
@@ -263,11 +269,7 @@ pub fn pyr_down_rgb8(
     s: &mut PyrScratch,
 ) -> Result<()> {
     let (w, h) = src.size();
-    if w < 2 || h < 2 {
-        return Err(ImageError::InvalidParameter(format!(
-            "cannot decimate a {w}x{h} image: both sides must be at least 2"
-        )));
-    }
+    check_decimable(w, h)?;
     let (ow, oh) = next_size(w, h);
     let [d0, d1, d2] = dst;
     for d in [&mut *d0, &mut *d1, &mut *d2] {
