@@ -4,6 +4,17 @@
 //!   error for a missing, unreadable, empty, corrupt or unsupported file.
 //! - [`npy`]: NumPy `.npy` arrays (read f32/f64 in C or Fortran order; write f32, C order).
 //! - [`pfm`]: Portable Float Map, single channel, as Middlebury writes it (rows bottom-up).
+//!
+//! ```
+//! use ocellus_image::Plane;
+//! let map = Plane::from_fn(4, 3, |x, y| (x + 10 * y) as f32);
+//! let bytes = ocellus_io::npy::encode_f32(&[3, 4], &map.to_vec());
+//! let back = ocellus_io::npy::parse(&bytes, std::path::Path::new("map.npy")).unwrap();
+//! assert_eq!(back.shape, vec![3, 4]);
+//! assert_eq!(back.data[5], 11.0); // row 1, column 1
+//! let err = ocellus_io::read_image("/no/such/file.png").unwrap_err();
+//! assert!(err.to_string().contains("no such file"));
+//! ```
 
 pub mod npy;
 pub mod pfm;

@@ -3,6 +3,11 @@
 //! - [`data_dir`]: the shared data folder (`../shared/data` beside the repository), or the
 //!   folder named by the `OCELLUS_DATA` environment variable.
 //! - [`assets_dir`]: the repository's own `assets/` (CC0 / public-domain images).
+//!
+//! ```
+//! let astronaut = ocellus_testdata::asset("astronaut.png");
+//! assert!(astronaut.is_file());
+//! ```
 
 use std::path::{Path, PathBuf};
 
