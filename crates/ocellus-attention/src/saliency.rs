@@ -2,6 +2,11 @@
 //!
 //! Build once per frame size with [`SaliencyEngine::new`]; [`SaliencyEngine::process`]
 //! reuses all buffers, so steady state allocates nothing.
+//!
+//! Channels are a list ([`crate::config::ChannelKind`]); each yields sub-features ([`Source`])
+//! whose pyramids go through the same center-surround and N(.) machinery. A new channel,
+//! such as flicker |I_t - I_{t-1}| for video, is one more `ChannelKind` and `Source` (plus
+//! the previous frame's intensity pyramid kept in the engine), not a new pipeline.
 
 use crate::center_surround::{abs_difference, attenuate_borders, ramp_width, scale_pairs, ScalePair};
 use crate::channels::{opponent_from_planes, opponent_planes, skin_plane, split_rgb};

@@ -89,3 +89,42 @@ pub fn from_image_gray8(img: &image::GrayImage) -> Plane<f32> {
         img.get_pixel(x as u32, y as u32).0[0] as f32 / 255.0
     })
 }
+
+/// An 8-bit grey `image` buffer as a grey plane.
+pub fn from_image_luma8(img: &image::GrayImage) -> Plane<u8> {
+    Plane::from_fn(img.width() as usize, img.height() as usize, |x, y| img.get_pixel(x as u32, y as u32).0[0])
+}
+
+/// A grey plane as an 8-bit grey `image` buffer.
+pub fn to_image_luma8(p: &Plane<u8>) -> image::GrayImage {
+    let (w, h) = p.size();
+    image::GrayImage::from_fn(w as u32, h as u32, |x, y| image::Luma([p.get(x as usize, y as usize)]))
+}
+
+/// An 8-bit RGB `image` buffer as an interleaved RGB plane.
+pub fn from_image_rgb8(img: &image::RgbImage) -> Plane<[u8; 3]> {
+    Plane::from_fn(img.width() as usize, img.height() as usize, |x, y| img.get_pixel(x as u32, y as u32).0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn image_crate_round_trips() {
+        let g = Plane::from_fn(7, 5, |x, y| (x * 30 + y) as u8);
+        assert_eq!(from_image_luma8(&to_image_luma8(&g)), g);
+        let c = Plane::from_fn(6, 4, |x, y| [x as u8, y as u8, (x * y) as u8]);
+        assert_eq!(from_image_rgb8(&to_image_rgb8(&c)), c);
+        let f = Plane::from_fn(3, 2, |x, _| x as f32 / 2.0);
+        let back = from_image_gray8(&to_image_gray8(&f, 0.0, 1.0));
+        assert!(back
+            .rows()
+            .zip(f.rows())
+            .all(|(a, b)| a.iter().zip(b).all(|(p, q)| (p - q).abs() <= 0.5 / 255.0 + 1e-6)));
+        let dynamic = image::DynamicImage::ImageLuma8(to_image_luma8(&g));
+        let rgb = from_dynamic(&dynamic).unwrap();
+        assert_eq!(rgb.get_f32(2, 1), [61.0 / 255.0; 3]);
+        assert!(from_dynamic(&image::DynamicImage::new_rgb8(0, 3)).is_err());
+    }
+}
