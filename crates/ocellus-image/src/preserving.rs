@@ -177,25 +177,27 @@ fn preserving_lanes_generic<M: Madd>(
             x += 1;
         }
     }
-    for (y, r) in rows.iter().enumerate() {
-        let out = dst.row_mut(y);
-        let mut x = 0;
-        while x < w && w >= 8 {
-            let x0 = if x + 8 <= w { x } else { w - 8 };
+    // Vertical pass in strips of 8 columns: a strip of all rows (8 px x 32 B x h) stays in
+    // L1, whereas whole rows (29 taps x 40 px x 32 B) would stream from L2 for every output row.
+    let mut x = 0;
+    while x < w && w >= 8 {
+        let x0 = if x + 8 <= w { x } else { w - 8 };
+        for (y, r) in rows.iter().enumerate() {
             let acc =
                 lanes_block::<M, 8>(r.len(), |i| r[i].1, |i| tmp.row(r[i].0)[x0..x0 + 8].try_into().unwrap_or(&Z));
-            out[x0..x0 + 8].copy_from_slice(&acc);
-            x = x0 + 8;
+            dst.row_mut(y)[x0..x0 + 8].copy_from_slice(&acc);
         }
-        while x < w {
+        x = x0 + 8;
+    }
+    for (y, r) in rows.iter().enumerate() {
+        for xx in x..w {
             let mut a = [0f32; 8];
             for &(ry, wt) in r {
                 for l in 0..8 {
-                    a[l] = M::madd(wt, tmp.row(ry)[x][l], a[l]);
+                    a[l] = M::madd(wt, tmp.row(ry)[xx][l], a[l]);
                 }
             }
-            out[x] = a;
-            x += 1;
+            dst.row_mut(y)[xx] = a;
         }
     }
 }
