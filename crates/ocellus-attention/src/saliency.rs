@@ -126,6 +126,7 @@ pub struct SaliencyEngine {
     normalizer: Normalizer,
     lanes: Plane<Lanes>,
     sub_sums: Vec<Plane<f32>>,
+    resample_row: Vec<f32>,
     conspicuity: Vec<Plane<f32>>,
     saliency: Plane<f32>,
     prior: Option<Plane<f32>>,
@@ -219,6 +220,7 @@ impl SaliencyEngine {
             features,
             normalizer,
             lanes: Plane::new(map_size.0, map_size.1),
+            resample_row: Vec::with_capacity(width),
             sub_sums: (0..subs.len()).map(|_| Plane::new(map_size.0, map_size.1)).collect(),
             conspicuity: (0..cfg.channels.len()).map(|_| Plane::new(map_size.0, map_size.1)).collect(),
             saliency: Plane::new(map_size.0, map_size.1),
@@ -410,9 +412,9 @@ impl SaliencyEngine {
                         .ok_or_else(|| AttentionError::InvalidInput("resampler".into()))?
                 }
             };
-            if rs.apply(m, &mut self.external[k][base]).is_err() {
+            if rs.apply_with(m, &mut self.external[k][base], &mut self.resample_row).is_err() {
                 let r = Resampler::new(ResampleMethod::Bilinear, m.size(), target)?;
-                r.apply(m, &mut self.external[k][base])?;
+                r.apply_with(m, &mut self.external[k][base], &mut self.resample_row)?;
                 self.external_resamplers[k] = Some(r);
             }
             Self::pyramid_up(b, &mut self.external[k], base, top, &cfg.pyramid, &mut self.pyr_scratch)?;
@@ -454,7 +456,7 @@ impl SaliencyEngine {
                     Source::External(k) => &self.external[k][l],
                 };
                 if let Some(r) = &self.resamplers[l] {
-                    r.apply(plane, &mut self.rescaled[s][l])?;
+                    r.apply_with(plane, &mut self.rescaled[s][l], &mut self.resample_row)?;
                 }
             }
         }
@@ -589,7 +591,7 @@ impl SaliencyEngine {
                 self.upsampler.as_ref().ok_or_else(|| AttentionError::InvalidInput("upsampler".into()))?
             }
         };
-        up.apply(&self.saliency, out)?;
+        up.apply_with(&self.saliency, out, &mut self.resample_row)?;
         Ok(())
     }
 }

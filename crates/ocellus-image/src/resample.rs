@@ -1,6 +1,7 @@
 //! Resampling a plane to another size with precomputed index tables.
 
-use crate::{ImageError, Plane, Result};
+use crate::simd::Madd;
+use crate::{dispatch_kernel, Backend, ImageError, Plane, Result};
 use serde::{Deserialize, Serialize};
 
 /// How samples are taken when changing size.
@@ -70,8 +71,9 @@ impl Resampler {
         self.dst
     }
 
-    /// Resamples `src` into `dst` (resized to the destination size).
-    pub fn apply(&self, src: &Plane<f32>, dst: &mut Plane<f32>) -> Result<()> {
+    /// Resamples `src` into `dst` (resized to the destination size); `row` is scratch space
+    /// (one source row), kept by the caller so that steady state allocates nothing.
+    pub fn apply_with(&self, src: &Plane<f32>, dst: &mut Plane<f32>, row: &mut Vec<f32>) -> Result<()> {
         if src.size() != self.src {
             return Err(ImageError::SizeMismatch {
                 what: "resampler input",
@@ -82,18 +84,45 @@ impl Resampler {
             });
         }
         dst.resize(self.dst.0, self.dst.1);
-        for (y, &(y0, y1, fy)) in self.ys.iter().enumerate() {
-            let (r0, r1) = (src.row(y0), src.row(y1));
-            let out = dst.row_mut(y);
-            for (o, &(x0, x1, fx)) in out.iter_mut().zip(&self.xs) {
-                let top = r0[x0] + fx * (r0[x1] - r0[x0]);
-                let bot = r1[x0] + fx * (r1[x1] - r1[x0]);
-                *o = top + fy * (bot - top);
-            }
-        }
+        resample_kernel(Backend::Auto, &self.xs, &self.ys, src, dst, row);
         Ok(())
     }
+
+    /// Like [`apply_with`](Self::apply_with) with a temporary row buffer (allocates).
+    pub fn apply(&self, src: &Plane<f32>, dst: &mut Plane<f32>) -> Result<()> {
+        self.apply_with(src, dst, &mut Vec::new())
+    }
 }
+
+/// Per output row: the vertical lerp of two source rows (whole rows, vectorized), then the
+/// horizontal lerp at the table's columns.
+#[inline(always)]
+fn resample_generic<M: Madd>(
+    xs: &AxisTable,
+    ys: &AxisTable,
+    src: &Plane<f32>,
+    dst: &mut Plane<f32>,
+    row: &mut Vec<f32>,
+) {
+    row.resize(src.width(), 0.0);
+    for (y, &(y0, y1, fy)) in ys.iter().enumerate() {
+        let (r0, r1) = (src.row(y0), src.row(y1));
+        if fy == 0.0 {
+            row.copy_from_slice(r0);
+        } else {
+            for ((o, &a), &b) in row.iter_mut().zip(r0).zip(r1) {
+                *o = M::madd(fy, b - a, a);
+            }
+        }
+        for (o, &(x0, x1, fx)) in dst.row_mut(y).iter_mut().zip(xs) {
+            *o = M::madd(fx, row[x1] - row[x0], row[x0]);
+        }
+    }
+}
+
+dispatch_kernel!(fn resample_kernel => resample_generic(
+    xs: &AxisTable, ys: &AxisTable, src: &Plane<f32>, dst: &mut Plane<f32>, row: &mut Vec<f32>
+));
 
 /// Allocating convenience: resample `src` to `w` x `h`.
 pub fn resize(src: &Plane<f32>, w: usize, h: usize, method: ResampleMethod) -> Result<Plane<f32>> {
