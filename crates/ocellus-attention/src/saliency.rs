@@ -402,20 +402,13 @@ impl SaliencyEngine {
         }
         let base = self.used_levels.first().copied().unwrap_or(0);
         for (k, m) in external.iter().enumerate() {
-            let target = self.sizes[base];
-            let rs = match &self.external_resamplers[k] {
-                Some(r) if r.dst_size() == target && self.external[k][base].size() == target => r,
-                _ => {
-                    self.external_resamplers[k] = Some(Resampler::new(ResampleMethod::Bilinear, m.size(), target)?);
-                    self.external_resamplers[k]
-                        .as_ref()
-                        .ok_or_else(|| AttentionError::InvalidInput("resampler".into()))?
-                }
-            };
-            if rs.apply_with(m, &mut self.external[k][base], &mut self.resample_row).is_err() {
-                let r = Resampler::new(ResampleMethod::Bilinear, m.size(), target)?;
-                r.apply_with(m, &mut self.external[k][base], &mut self.resample_row)?;
-                self.external_resamplers[k] = Some(r);
+            // Maps may change size between frames; the resampler follows the map's size.
+            if self.external_resamplers[k].as_ref().map(|r| r.src_size()) != Some(m.size()) {
+                self.external_resamplers[k] =
+                    Some(Resampler::new(ResampleMethod::Bilinear, m.size(), self.sizes[base])?);
+            }
+            if let Some(rs) = &self.external_resamplers[k] {
+                rs.apply_with(m, &mut self.external[k][base], &mut self.resample_row)?;
             }
             Self::pyramid_up(b, &mut self.external[k], base, top, &cfg.pyramid, &mut self.pyr_scratch)?;
         }
@@ -583,15 +576,13 @@ impl SaliencyEngine {
 
     /// The saliency map resampled (bilinear, pixel centres aligned) to the input size.
     pub fn saliency_full_size(&mut self, out: &mut Plane<f32>) -> Result<()> {
-        let up = match &self.upsampler {
-            Some(u) => u,
-            None => {
-                self.upsampler =
-                    Some(Resampler::new(ResampleMethod::Bilinear, self.map_size(), (self.width, self.height))?);
-                self.upsampler.as_ref().ok_or_else(|| AttentionError::InvalidInput("upsampler".into()))?
-            }
-        };
-        up.apply_with(&self.saliency, out, &mut self.resample_row)?;
+        if self.upsampler.is_none() {
+            self.upsampler =
+                Some(Resampler::new(ResampleMethod::Bilinear, self.map_size(), (self.width, self.height))?);
+        }
+        if let Some(up) = &self.upsampler {
+            up.apply_with(&self.saliency, out, &mut self.resample_row)?;
+        }
         Ok(())
     }
 }

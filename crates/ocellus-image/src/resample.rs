@@ -66,6 +66,11 @@ impl Resampler {
         Ok(Self { src, dst, xs, ys })
     }
 
+    /// Source size (w, h).
+    pub fn src_size(&self) -> (usize, usize) {
+        self.src
+    }
+
     /// Destination size (w, h).
     pub fn dst_size(&self) -> (usize, usize) {
         self.dst
