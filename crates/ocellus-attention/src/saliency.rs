@@ -39,6 +39,34 @@ pub enum Source {
     External(usize),
 }
 
+/// The Gaussian pyramids of one frame, levels 0..=max_level; levels a source does not need
+/// stay empty.
+#[derive(Debug)]
+struct Pyramids {
+    /// R, G, B (when opponency is computed at each level).
+    rgb: [Vec<Plane<f32>>; 3],
+    /// Intensity, red-green, blue-yellow.
+    opp: [Vec<Plane<f32>>; 3],
+    /// Gabor energy, per level then per angle.
+    ori: Vec<Vec<Plane<f32>>>,
+    skin: Vec<Plane<f32>>,
+    external: Vec<Vec<Plane<f32>>>,
+}
+
+impl Pyramids {
+    /// Level `level` of `source`'s pyramid.
+    fn get(&self, source: Source, level: usize) -> Option<&Plane<f32>> {
+        match source {
+            Source::Intensity => self.opp[0].get(level),
+            Source::RedGreen => self.opp[1].get(level),
+            Source::BlueYellow => self.opp[2].get(level),
+            Source::Orientation(a) => self.ori.get(level).and_then(|v| v.get(a)),
+            Source::Skin => self.skin.get(level),
+            Source::External(k) => self.external.get(k).and_then(|v| v.get(level)),
+        }
+    }
+}
+
 /// One sub-feature: a pyramid whose center-surround maps are normalized together.
 #[derive(Clone, Debug)]
 pub struct SubFeature {
@@ -111,12 +139,7 @@ pub struct SaliencyEngine {
     used_levels: Vec<usize>,
     subs: Vec<SubFeature>,
     n_external: usize,
-    // pyramids, levels 0..=max_level; levels a source does not need stay empty
-    rgb: [Vec<Plane<f32>>; 3],
-    opp: [Vec<Plane<f32>>; 3],
-    ori: Vec<Vec<Plane<f32>>>,
-    skin: Vec<Plane<f32>>,
-    external: Vec<Vec<Plane<f32>>>,
+    pyr: Pyramids,
     pyr_scratch: PyrScratch,
     gabor: Option<GaborBank>,
     resamplers: Vec<Option<Resampler>>,
@@ -207,11 +230,13 @@ impl SaliencyEngine {
             width,
             height,
             sizes,
-            rgb: [empty_pyr(n), empty_pyr(n), empty_pyr(n)],
-            opp: [empty_pyr(n), empty_pyr(n), empty_pyr(n)],
-            ori: (0..n).map(|_| empty_pyr(n_angles)).collect(),
-            skin: empty_pyr(n),
-            external: (0..n_external).map(|_| empty_pyr(n)).collect(),
+            pyr: Pyramids {
+                rgb: [empty_pyr(n), empty_pyr(n), empty_pyr(n)],
+                opp: [empty_pyr(n), empty_pyr(n), empty_pyr(n)],
+                ori: (0..n).map(|_| empty_pyr(n_angles)).collect(),
+                skin: empty_pyr(n),
+                external: (0..n_external).map(|_| empty_pyr(n)).collect(),
+            },
             pyr_scratch: PyrScratch::default(),
             gabor,
             resamplers,
@@ -354,16 +379,16 @@ impl SaliencyEngine {
         if need_i || need_c {
             match cfg.opponency_at {
                 OpponencyStage::Input => {
-                    let [i, rg, by] = &mut self.opp;
+                    let [i, rg, by] = &mut self.pyr.opp;
                     opponent_planes(b, frame, weights, cfg.color_threshold, [&mut i[0], &mut rg[0], &mut by[0]]);
-                    for (k, p) in self.opp.iter_mut().enumerate() {
+                    for (k, p) in self.pyr.opp.iter_mut().enumerate() {
                         if (k == 0 && need_i) || (k > 0 && need_c) {
                             Self::pyramid_up(b, p, 0, top, &cfg.pyramid, &mut self.pyr_scratch)?;
                         }
                     }
                 }
                 OpponencyStage::EachLevel => {
-                    let [r, g, bl] = &mut self.rgb;
+                    let [r, g, bl] = &mut self.pyr.rgb;
                     let first = match frame {
                         // 8-bit input: conversion fused into the first level (no full-size floats).
                         RgbImage::U8(p) if top >= 1 && self.used_levels.first().is_some_and(|&l| l >= 1) => {
@@ -381,13 +406,13 @@ impl SaliencyEngine {
                             0
                         }
                     };
-                    for p in self.rgb.iter_mut() {
+                    for p in self.pyr.rgb.iter_mut() {
                         Self::pyramid_up(b, p, first, top, &cfg.pyramid, &mut self.pyr_scratch)?;
                     }
                     for &l in &self.used_levels {
-                        let [i, rg, by] = &mut self.opp;
+                        let [i, rg, by] = &mut self.pyr.opp;
                         opponent_from_planes(
-                            [&self.rgb[0][l], &self.rgb[1][l], &self.rgb[2][l]],
+                            [&self.pyr.rgb[0][l], &self.pyr.rgb[1][l], &self.pyr.rgb[2][l]],
                             weights,
                             cfg.color_threshold,
                             [&mut i[l], &mut rg[l], &mut by[l]],
@@ -397,8 +422,8 @@ impl SaliencyEngine {
             }
         }
         if needs(ChannelKind::Skin) {
-            skin_plane(frame, cfg.color_threshold, &mut self.skin[0]);
-            Self::pyramid_up(b, &mut self.skin, 0, top, &cfg.pyramid, &mut self.pyr_scratch)?;
+            skin_plane(frame, cfg.color_threshold, &mut self.pyr.skin[0]);
+            Self::pyramid_up(b, &mut self.pyr.skin, 0, top, &cfg.pyramid, &mut self.pyr_scratch)?;
         }
         let base = self.used_levels.first().copied().unwrap_or(0);
         for (k, m) in external.iter().enumerate() {
@@ -408,9 +433,9 @@ impl SaliencyEngine {
                     Some(Resampler::new(ResampleMethod::Bilinear, m.size(), self.sizes[base])?);
             }
             if let Some(rs) = &self.external_resamplers[k] {
-                rs.apply_with(m, &mut self.external[k][base], &mut self.resample_row)?;
+                rs.apply_with(m, &mut self.pyr.external[k][base], &mut self.resample_row)?;
             }
-            Self::pyramid_up(b, &mut self.external[k], base, top, &cfg.pyramid, &mut self.pyr_scratch)?;
+            Self::pyramid_up(b, &mut self.pyr.external[k], base, top, &cfg.pyramid, &mut self.pyr_scratch)?;
         }
         Ok(())
     }
@@ -418,36 +443,21 @@ impl SaliencyEngine {
     fn build_orientations(&mut self) -> Result<()> {
         let Some(g) = self.gabor.as_mut() else { return Ok(()) };
         for &l in &self.used_levels {
-            g.filter(self.backend, &self.opp[0][l], &mut self.ori[l])?;
+            g.filter(self.backend, &self.pyr.opp[0][l], &mut self.pyr.ori[l])?;
         }
         Ok(())
     }
 
     /// A pyramid level of a source (empty if that level is not computed).
     pub fn level(&self, source: Source, level: usize) -> Option<&Plane<f32>> {
-        let p = match source {
-            Source::Intensity => self.opp[0].get(level),
-            Source::RedGreen => self.opp[1].get(level),
-            Source::BlueYellow => self.opp[2].get(level),
-            Source::Orientation(a) => self.ori.get(level).and_then(|v| v.get(a)),
-            Source::Skin => self.skin.get(level),
-            Source::External(k) => self.external.get(k).and_then(|v| v.get(level)),
-        }?;
-        (!p.is_empty()).then_some(p)
+        self.pyr.get(source, level).filter(|p| !p.is_empty())
     }
 
     fn rescale(&mut self) -> Result<()> {
         for s in 0..self.subs.len() {
             let src = self.subs[s].source;
             for &l in &self.used_levels {
-                let plane = match src {
-                    Source::Intensity => &self.opp[0][l],
-                    Source::RedGreen => &self.opp[1][l],
-                    Source::BlueYellow => &self.opp[2][l],
-                    Source::Orientation(a) => &self.ori[l][a],
-                    Source::Skin => &self.skin[l],
-                    Source::External(k) => &self.external[k][l],
-                };
+                let Some(plane) = self.pyr.get(src, l) else { continue };
                 if let Some(r) = &self.resamplers[l] {
                     r.apply_with(plane, &mut self.rescaled[s][l], &mut self.resample_row)?;
                 }
