@@ -13,7 +13,12 @@ use clap::{Parser, Subcommand};
 
 /// Fast, biologically inspired active vision: where to look, how it moved, where things are.
 #[derive(Parser, Debug)]
-#[command(name = "ocellus", version, about, long_about = None)]
+#[command(
+    name = "ocellus",
+    version,
+    about = "Fast, biologically inspired active vision for robots: saliency (where to look), and more to come",
+    long_about = None
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
