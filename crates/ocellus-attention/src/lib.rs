@@ -20,6 +20,7 @@
 //! assert!(map.all_finite());
 //! ```
 
+pub mod center_prior;
 pub mod center_surround;
 pub mod channels;
 pub mod combine;
