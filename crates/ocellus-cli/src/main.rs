@@ -4,6 +4,7 @@ mod assets;
 mod bench;
 mod config_file;
 mod demo;
+mod eval;
 mod inputs;
 mod overlay;
 mod saliency_cmd;
@@ -30,6 +31,8 @@ enum Command {
     Demo(demo::DemoArgs),
     /// Compute bottom-up saliency maps (Itti-Koch-Niebur) for images or folders of images.
     Saliency(saliency_cmd::SaliencyArgs),
+    /// Score saliency maps against human fixation maps (CC, SIM, KL; MIT benchmark definitions).
+    Eval(eval::EvalArgs),
     /// Print benchmark figures (median ms per frame, fps on all cores, per stage, peak memory).
     Bench(bench::BenchArgs),
 }
@@ -40,6 +43,7 @@ fn main() {
         Command::Demo(a) => demo::run(a),
         Command::Saliency(a) => saliency_cmd::run(a),
         Command::Bench(a) => bench::run(a),
+        Command::Eval(a) => eval::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

@@ -107,3 +107,55 @@ fn demo_runs_on_built_in_images() {
     assert!(out.join("ace2009/astronaut.overlay.png").is_file());
     assert!(out.join("stb/rocket.saliency.npy").is_file());
 }
+
+#[test]
+fn eval_scores_models_against_fixation_maps() {
+    let d = ocellus_testdata::data_file("mit1003");
+    let (stim, fix) = (d.join("stimuli"), d.join("fixation_maps"));
+    // The fixation maps scored as if they were a model's maps: a perfect score.
+    let o = ocellus()
+        .args(["eval", "--limit", "3", "--model"])
+        .arg(format!("maps:{}", fix.display()))
+        .arg("--stimuli")
+        .arg(&stim)
+        .arg("--fixations")
+        .arg(&fix)
+        .output()
+        .unwrap();
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{s} {}", String::from_utf8_lossy(&o.stderr));
+    let value = |name: &str| -> f64 {
+        s.lines()
+            .find(|l| l.starts_with(name))
+            .and_then(|l| l.split_whitespace().nth(1))
+            .and_then(|v| v.parse().ok())
+            .unwrap()
+    };
+    assert!((value("CC") - 1.0).abs() < 1e-9 && (value("SIM") - 1.0).abs() < 1e-9 && value("KL").abs() < 1e-6, "{s}");
+    // The saliency model with the centre prior, per-image JSON written.
+    let out = tmpdir("eval");
+    let json = out.join("eval.json");
+    let o = ocellus()
+        .args(["eval", "--limit", "2", "--center-prior", "--model", "ocellus:ace2009", "--stimuli"])
+        .arg(&stim)
+        .arg("--fixations")
+        .arg(&fix)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(v["images"].as_array().unwrap().len(), 2);
+    let cc = v["images"][0]["CC"].as_f64().unwrap();
+    assert!(cc > 0.0 && cc <= 1.0);
+    let o = ocellus()
+        .args(["eval", "--model", "nonsense", "--stimuli"])
+        .arg(&stim)
+        .arg("--fixations")
+        .arg(&fix)
+        .args(["--limit", "1"])
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+}
