@@ -206,6 +206,26 @@ fn auc_thresholds(pos: &[f64], neg: &[f64], step: f64) -> f64 {
     trapezoid(&fp, &tp)
 }
 
+/// Shared set-up of the split AUCs: checks, the min-max normalized map and its values at the
+/// fixations.
+fn split_auc_setup(
+    metric: &'static str,
+    saliency: &Plane<f64>,
+    fixations: &[(usize, usize)],
+    splits: usize,
+    step: f64,
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    let mut s = values(saliency);
+    check(metric, &s)?;
+    let idx = fixation_indices(metric, saliency, fixations)?;
+    if splits == 0 || !step.is_finite() || step <= 0.0 {
+        return Err(EvalError::Undefined { metric, why: "needs splits >= 1 and step > 0".into() });
+    }
+    min_max_normalize(&mut s);
+    let pos = idx.iter().map(|&i| s[i]).collect();
+    Ok((s, pos))
+}
+
 /// AUC-Borji: min-max normalized map; `splits` times, as many uniformly random pixels (with
 /// replacement) as fixations serve as negatives; thresholds `0:step:max` (benchmark: 100
 /// splits, step 0.1); mean area.
@@ -216,14 +236,7 @@ pub fn auc_borji(
     step: f64,
     seed: u64,
 ) -> Result<f64> {
-    let mut s = values(saliency);
-    check("AUC-Borji", &s)?;
-    let idx = fixation_indices("AUC-Borji", saliency, fixations)?;
-    if splits == 0 || !step.is_finite() || step <= 0.0 {
-        return Err(EvalError::Undefined { metric: "AUC-Borji", why: "needs splits >= 1 and step > 0".into() });
-    }
-    min_max_normalize(&mut s);
-    let pos: Vec<f64> = idx.iter().map(|&i| s[i]).collect();
+    let (s, pos) = split_auc_setup("AUC-Borji", saliency, fixations, splits, step)?;
     let mut rng = SplitMix64::new(seed);
     let total: f64 = (0..splits)
         .map(|_| {
@@ -245,15 +258,8 @@ pub fn auc_shuffled(
     step: f64,
     seed: u64,
 ) -> Result<f64> {
-    let mut s = values(saliency);
-    check("sAUC", &s)?;
-    let idx = fixation_indices("sAUC", saliency, fixations)?;
+    let (s, pos) = split_auc_setup("sAUC", saliency, fixations, splits, step)?;
     let mut other = fixation_indices("sAUC", saliency, other_fixations)?;
-    if splits == 0 || !step.is_finite() || step <= 0.0 {
-        return Err(EvalError::Undefined { metric: "sAUC", why: "needs splits >= 1 and step > 0".into() });
-    }
-    min_max_normalize(&mut s);
-    let pos: Vec<f64> = idx.iter().map(|&i| s[i]).collect();
     let n_neg = pos.len().min(other.len());
     let mut rng = SplitMix64::new(seed);
     let mut total = 0.0;
