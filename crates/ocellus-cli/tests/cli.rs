@@ -159,3 +159,65 @@ fn eval_scores_models_against_fixation_maps() {
         .unwrap();
     assert!(!o.status.success());
 }
+
+/// The values of the `eval` table, by metric name.
+fn eval_table(stdout: &str) -> std::collections::HashMap<String, f64> {
+    stdout
+        .lines()
+        .filter_map(|l| {
+            let mut f = l.split_whitespace();
+            Some((f.next()?.to_string(), f.next()?.parse().ok()?))
+        })
+        .collect()
+}
+
+#[test]
+fn eval_location_metrics_from_csv_points_and_binary_maps_agree() {
+    let d = ocellus_testdata::data_file("mit1003");
+    let (stim, fix) = (d.join("stimuli"), d.join("fixation_maps"));
+    let (csv_dir, png_dir) = (tmpdir("points-csv"), tmpdir("points-png"));
+    let mut names: Vec<PathBuf> = std::fs::read_dir(&fix).unwrap().map(|e| e.unwrap().path()).collect();
+    names.sort();
+    let stim_sub = tmpdir("points-stimuli");
+    for p in names.iter().take(3) {
+        // The 25 densest pixels of the human density map stand in for fixations.
+        let g = image::open(p).unwrap().to_luma8();
+        let mut px: Vec<(u8, u32, u32)> = g.enumerate_pixels().map(|(x, y, v)| (v.0[0], x, y)).collect();
+        px.sort_by(|a, b| b.cmp(a));
+        let stem = p.file_stem().unwrap().to_str().unwrap().to_string();
+        let mut csv = String::from("x,y\n");
+        let mut bin = image::GrayImage::new(g.width(), g.height());
+        for &(_, x, y) in px.iter().take(25) {
+            csv.push_str(&format!("{x},{y}\n"));
+            bin.put_pixel(x, y, image::Luma([255]));
+        }
+        std::fs::write(csv_dir.join(format!("{stem}.csv")), csv).unwrap();
+        bin.save(png_dir.join(format!("{stem}.png"))).unwrap();
+        let s = std::fs::read_dir(&stim).unwrap().map(|e| e.unwrap().path()).find(|s| s.file_stem() == p.file_stem());
+        let s = s.unwrap();
+        std::fs::copy(&s, stim_sub.join(s.file_name().unwrap())).unwrap();
+    }
+    let run = |model: String, points: &PathBuf| {
+        let o = ocellus()
+            .args(["eval", "--model", &model, "--stimuli"])
+            .arg(&stim_sub)
+            .arg("--points")
+            .arg(points)
+            .output()
+            .unwrap();
+        let s = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(o.status.success(), "{s} {}", String::from_utf8_lossy(&o.stderr));
+        assert!(s.contains("need fixation density maps"), "no density maps given: {s}");
+        eval_table(&s)
+    };
+    let density_model = format!("maps:{}", fix.display());
+    let (a, b) = (run(density_model.clone(), &csv_dir), run(density_model, &png_dir));
+    for m in ["NSS", "AUC-Judd", "AUC-Borji", "sAUC", "IG"] {
+        assert!((a[m] - b[m]).abs() < 1e-12, "{m}: csv {} vs binary map {}", a[m], b[m]);
+    }
+    // Fixations at the density maxima: the density map is an almost perfect predictor of them.
+    assert!(a["NSS"] > 3.0 && a["AUC-Judd"] > 0.99 && a["AUC-Borji"] > 0.95, "{a:?}");
+    assert!(a["IG"] > 0.0, "beats the centre baseline: {a:?}");
+    let c = run("centre".into(), &csv_dir);
+    assert!(c["NSS"] < a["NSS"] && c["IG"].abs() < 1e-9, "centre model is the IG baseline: {c:?}");
+}

@@ -4,6 +4,7 @@
 //!   error for a missing, unreadable, empty, corrupt or unsupported file.
 //! - [`npy`]: NumPy `.npy` arrays (read f32/f64 in C or Fortran order; write f32, C order).
 //! - [`pfm`]: Portable Float Map, single channel, as Middlebury writes it (rows bottom-up).
+//! - [`points`]: CSV files of 2D points (fixations), in pixels.
 //!
 //! ```
 //! use ocellus_image::Plane;
@@ -18,6 +19,7 @@
 
 pub mod npy;
 pub mod pfm;
+pub mod points;
 
 use ocellus_image::convert::{from_dynamic, RgbImage};
 use std::path::{Path, PathBuf};

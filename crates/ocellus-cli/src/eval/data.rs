@@ -1,0 +1,169 @@
+//! Finding and loading what `ocellus eval` scores: stimuli, density maps, fixation points.
+
+use super::{model_map, progress, EvalArgs, Model};
+use crate::inputs;
+use anyhow::{bail, Context, Result};
+use ocellus_image::Plane;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// One stimulus and its fixation data.
+pub struct Item {
+    /// File stem shared by the stimulus and its fixation files.
+    pub name: String,
+    pub stimulus: PathBuf,
+    pub density: Option<PathBuf>,
+    pub points: Option<PathBuf>,
+}
+
+/// One image ready to score: the model's map (None for `centre`), the fixation data, and the
+/// size every metric works at (the density map's, else the binary fixation map's, else the stimulus's).
+pub struct Sample {
+    pub map: Option<Plane<f32>>,
+    pub density: Option<Plane<f64>>,
+    pub fixations: Option<Vec<(usize, usize)>>,
+    pub size: (usize, usize),
+}
+
+fn files_with_stem(dir: &Path, stem: &str) -> Vec<PathBuf> {
+    let Ok(rd) = std::fs::read_dir(dir) else { return Vec::new() };
+    let mut v: Vec<PathBuf> = rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| inputs::stem(p) == stem).collect();
+    v.sort();
+    v
+}
+
+/// The image file in `dir` named `stem.*`.
+pub fn find_same_stem(dir: &Path, stem: &str) -> Option<PathBuf> {
+    files_with_stem(dir, stem).into_iter().find(|p| ocellus_io::is_image_path(p))
+}
+
+fn is_csv(p: &Path) -> bool {
+    p.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("csv"))
+}
+
+/// The points file in `dir` named `stem.csv`, or else a binary fixation map `stem.<image>`.
+fn find_points(dir: &Path, stem: &str) -> Option<PathBuf> {
+    let files = files_with_stem(dir, stem);
+    let csv = files.iter().find(|p| is_csv(p)).cloned();
+    csv.or_else(|| files.into_iter().find(|p| ocellus_io::is_image_path(p)))
+}
+
+/// An image as grey values in [0, 1] (mean of R, G, B).
+pub fn grey(path: &Path) -> Result<Plane<f32>> {
+    let img = ocellus_io::read_image(path)?;
+    let (w, h) = img.size();
+    Ok(Plane::from_fn(w, h, |x, y| {
+        let c = img.get_f32(x, y);
+        (c[0] + c[1] + c[2]) / 3.0
+    }))
+}
+
+/// The stimuli of `--stimuli` with their density maps and points files.
+pub fn collect_items(a: &EvalArgs) -> Result<Vec<Item>> {
+    let stimuli = inputs::collect_images(std::slice::from_ref(&a.stimuli))?;
+    let mut items = Vec::new();
+    for s in stimuli {
+        let name = inputs::stem(&s);
+        let density = match &a.fixations {
+            Some(dir) => Some(
+                find_same_stem(dir, &name)
+                    .with_context(|| format!("no fixation map named {name} in {}", dir.display()))?,
+            ),
+            None => None,
+        };
+        let points = match &a.points {
+            Some(dir) => Some(
+                find_points(dir, &name)
+                    .with_context(|| format!("no {name}.csv or fixation map {name}.* in {}", dir.display()))?,
+            ),
+            None => None,
+        };
+        items.push(Item { name, stimulus: s, density, points });
+    }
+    if let Some(n) = a.limit {
+        items.truncate(n);
+    }
+    if items.is_empty() {
+        bail!("no stimuli found in {}", a.stimuli.display());
+    }
+    Ok(items)
+}
+
+/// Fixation pixels as (column, row).
+type Pixels = Vec<(usize, usize)>;
+
+/// Fixation pixels of a binary map: pixels at least half as bright as white (robust to JPEG
+/// noise); and the map's size.
+fn fixations_of_binary_map(path: &Path) -> Result<(Pixels, (usize, usize))> {
+    let g = grey(path)?;
+    let size = g.size();
+    let b = g.map(|v| if v >= 0.5 { 1.0f64 } else { 0.0 });
+    Ok((ocellus_eval::metrics::fixations_from_map(&b), size))
+}
+
+fn load_sample(item: &Item, model: &Model, engine: &mut Option<ocellus_attention::SaliencyEngine>) -> Result<Sample> {
+    let map = model_map(model, item, engine)?;
+    let density = match &item.density {
+        Some(p) => Some(grey(p)?.map(|v| v as f64)),
+        None => None,
+    };
+    let (mut fixations, mut size) = (None, density.as_ref().map(|d| d.size()));
+    if let Some(p) = &item.points {
+        if is_csv(p) {
+            let pts = ocellus_io::points::read_points(p)?;
+            let (w, h) = match size {
+                Some(s) => s,
+                None => ocellus_io::read_image(&item.stimulus)?.size(),
+            };
+            size = Some((w, h));
+            fixations = Some(ocellus_io::points::to_pixels(&pts, w, h));
+        } else {
+            let (f, s) = fixations_of_binary_map(p)?;
+            if let Some(ds) = size.filter(|&ds| ds != s) {
+                bail!("{}: fixation map is {}x{}, density map is {}x{}", p.display(), s.0, s.1, ds.0, ds.1);
+            }
+            size = Some(s);
+            fixations = Some(f);
+        }
+    }
+    let Some(size) = size else { bail!("{}: no fixation data", item.name) };
+    if fixations.as_ref().is_some_and(|f| f.is_empty()) {
+        bail!("{}: no fixation inside the image", item.name);
+    }
+    Ok(Sample { map, density, fixations, size })
+}
+
+/// Loads every item (maps computed in parallel, one engine per worker), with a progress bar.
+pub fn load_samples(items: &[Item], model: &Model) -> Result<Vec<Sample>> {
+    let bar = progress(items.len(), "maps");
+    let samples = items
+        .par_iter()
+        .map_init(
+            || None,
+            |engine, item| -> Result<Sample> {
+                let s = load_sample(item, model, engine).with_context(|| item.name.clone())?;
+                bar.inc(1);
+                Ok(s)
+            },
+        )
+        .collect::<Result<Vec<_>>>()?;
+    bar.finish_and_clear();
+    Ok(samples)
+}
+
+/// The fixations of every image but `i`, rescaled to image `i`'s pixels (pixel centres map to
+/// pixel centres): the negatives of the shuffled AUC.
+pub fn other_fixations(samples: &[Sample], i: usize) -> Vec<(usize, usize)> {
+    let (w, h) = samples[i].size;
+    let mut out = Vec::new();
+    for (j, s) in samples.iter().enumerate() {
+        let (Some(f), true) = (&s.fixations, j != i) else { continue };
+        let (sx, sy) = (w as f64 / s.size.0 as f64, h as f64 / s.size.1 as f64);
+        out.extend(f.iter().map(|&(x, y)| {
+            let tx = ((x as f64 + 0.5) * sx - 0.5).round().clamp(0.0, (w - 1) as f64);
+            let ty = ((y as f64 + 0.5) * sy - 0.5).round().clamp(0.0, (h - 1) as f64);
+            (tx as usize, ty as usize)
+        }));
+    }
+    out
+}

@@ -1,0 +1,91 @@
+//! Fixation points (or any 2D image points) as CSV text.
+//!
+//! One point per line, `x,y` in pixels of the stimulus: x to the right, y down, origin at the
+//! top-left corner, pixel centres at integer coordinates (so `3,5` is the pixel in column 3,
+//! row 5, and `3.4,5.6` rounds to it). Separators may be commas, semicolons, tabs or spaces;
+//! further columns (a subject id, a duration) are ignored. Blank lines and lines starting with
+//! `#` are skipped, and so is a first line whose first two fields are not numbers (a header).
+
+use crate::{read_bytes, IoError, Result};
+use std::path::Path;
+
+/// Reads a CSV file of points; see the module documentation for the format.
+pub fn read_points(path: impl AsRef<Path>) -> Result<Vec<[f64; 2]>> {
+    let path = path.as_ref();
+    let bytes = read_bytes(path)?;
+    parse(&bytes, path)
+}
+
+/// Parses CSV text of points; `path` only names the source in errors.
+pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<[f64; 2]>> {
+    let invalid = |reason: String| IoError::Invalid { path: path.into(), reason };
+    let text = std::str::from_utf8(bytes).map_err(|e| invalid(format!("not UTF-8 text: {e}")))?;
+    let mut points = Vec::new();
+    let mut first_content_line = true;
+    for (n, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let mut fields = line.split([',', ';', '\t', ' ']).map(str::trim).filter(|f| !f.is_empty());
+        let (fx, fy) = (fields.next().unwrap_or(""), fields.next().unwrap_or(""));
+        let parsed = (fx.parse::<f64>(), fy.parse::<f64>());
+        let is_header = first_content_line && (parsed.0.is_err() || parsed.1.is_err());
+        first_content_line = false;
+        if is_header {
+            continue;
+        }
+        let (Ok(x), Ok(y)) = parsed else {
+            return Err(invalid(format!("line {}: expected 'x,y' in pixels, got '{line}'", n + 1)));
+        };
+        if !x.is_finite() || !y.is_finite() {
+            return Err(invalid(format!("line {}: non-finite coordinate in '{line}'", n + 1)));
+        }
+        points.push([x, y]);
+    }
+    Ok(points)
+}
+
+/// The pixels (column, row) holding `points`, for an image of `width` x `height`: each point
+/// rounds to its nearest pixel centre; points outside the image are dropped.
+pub fn to_pixels(points: &[[f64; 2]], width: usize, height: usize) -> Vec<(usize, usize)> {
+    points
+        .iter()
+        .filter_map(|&[x, y]| {
+            let (cx, cy) = (x.round(), y.round());
+            let inside = cx >= 0.0 && cy >= 0.0 && cx < width as f64 && cy < height as f64;
+            inside.then_some((cx as usize, cy as usize))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(s: &str) -> Result<Vec<[f64; 2]>> {
+        parse(s.as_bytes(), Path::new("t.csv"))
+    }
+
+    #[test]
+    fn header_comments_separators_and_extra_columns() {
+        let v = p("x,y,subject\n# a comment\n1,2,7\n\n3.5;4\n5\t6\n 7 8 \n").unwrap();
+        assert_eq!(v, vec![[1.0, 2.0], [3.5, 4.0], [5.0, 6.0], [7.0, 8.0]]);
+    }
+
+    #[test]
+    fn bad_lines_are_errors_with_line_numbers() {
+        let e = p("1,2\n3,abc\n").unwrap_err().to_string();
+        assert!(e.contains("line 2"), "{e}");
+        assert!(p("1,2\nNaN,3\n").unwrap_err().to_string().contains("non-finite"));
+        assert!(p("1\n").is_ok(), "a lone first line is a header");
+        assert!(p("1,2\n7\n").is_err());
+        assert!(parse(&[0xff, 0xfe], Path::new("t.csv")).is_err());
+    }
+
+    #[test]
+    fn pixels_round_to_centres_and_drop_outside() {
+        let px = to_pixels(&[[0.4, 0.6], [-0.4, 0.0], [-0.6, 0.0], [9.49, 4.0], [9.5, 4.0], [2.0, 5.0]], 10, 5);
+        assert_eq!(px, vec![(0, 1), (0, 0), (9, 4)]);
+    }
+}
