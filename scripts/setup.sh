@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Installs the system packages ocellus needs on a fresh Debian machine.
-# Today the build needs only a Rust toolchain and a C compiler (for nothing yet: all
-# dependencies are pure Rust); later features add ffmpeg and a software Vulkan driver here.
+# The build needs a Rust toolchain and a C compiler; video input (ocellus attend/surprise and
+# their tests) runs the ffmpeg program as a subprocess.
 set -euo pipefail
 
 need=()
 command -v cc >/dev/null 2>&1 || need+=(gcc)
 command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
+command -v ffmpeg >/dev/null 2>&1 || need+=(ffmpeg)
 
 if [ ${#need[@]} -gt 0 ]; then
   if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi

@@ -125,6 +125,9 @@ pub enum ChannelKind {
     Orientation,
     /// Skin chromaticity likelihood (see [`crate::channels::skin_likelihood`]): one sub-feature.
     Skin,
+    /// Flicker (SPEC 1.8): `|I_t - I_(t-1)|` on each intensity pyramid level, against the
+    /// previous frame given to the same engine; flat (no contribution) on the first frame.
+    Flicker,
     /// A map supplied with each frame by the caller (e.g. a detector's output), by name.
     External(String),
 }
@@ -137,6 +140,7 @@ impl ChannelKind {
             ChannelKind::Color => "color".into(),
             ChannelKind::Orientation => "orientation".into(),
             ChannelKind::Skin => "skin".into(),
+            ChannelKind::Flicker => "flicker".into(),
             ChannelKind::External(n) => format!("external:{n}"),
         }
     }

@@ -35,6 +35,8 @@ pub enum Source {
     Orientation(usize),
     /// Skin likelihood.
     Skin,
+    /// `|I_t - I_(t-1)|` of the intensity pyramid.
+    Flicker,
     /// The n-th external map.
     External(usize),
 }
@@ -50,6 +52,9 @@ struct Pyramids {
     /// Gabor energy, per level then per angle.
     ori: Vec<Vec<Plane<f32>>>,
     skin: Vec<Plane<f32>>,
+    flicker: Vec<Plane<f32>>,
+    /// The previous frame's intensity levels (for flicker); empty before the first frame.
+    prev_intensity: Vec<Plane<f32>>,
     external: Vec<Vec<Plane<f32>>>,
 }
 
@@ -62,6 +67,7 @@ impl Pyramids {
             Source::BlueYellow => self.opp[2].get(level),
             Source::Orientation(a) => self.ori.get(level).and_then(|v| v.get(a)),
             Source::Skin => self.skin.get(level),
+            Source::Flicker => self.flicker.get(level),
             Source::External(k) => self.external.get(k).and_then(|v| v.get(level)),
         }
     }
@@ -192,6 +198,7 @@ impl SaliencyEngine {
                     }
                 }
                 ChannelKind::Skin => push(Source::Skin, "skin".into()),
+                ChannelKind::Flicker => push(Source::Flicker, "flicker".into()),
                 ChannelKind::External(name) => {
                     push(Source::External(n_external), format!("external {name}"));
                     n_external += 1;
@@ -235,6 +242,8 @@ impl SaliencyEngine {
                 opp: [empty_pyr(n), empty_pyr(n), empty_pyr(n)],
                 ori: (0..n).map(|_| empty_pyr(n_angles)).collect(),
                 skin: empty_pyr(n),
+                flicker: empty_pyr(n),
+                prev_intensity: empty_pyr(n),
                 external: (0..n_external).map(|_| empty_pyr(n)).collect(),
             },
             pyr_scratch: PyrScratch::default(),
@@ -373,7 +382,7 @@ impl SaliencyEngine {
         let (b, top) = (self.backend, self.max_level());
         let cfg = &self.cfg;
         let needs = |k: ChannelKind| cfg.channels.iter().any(|c| c.kind == k);
-        let need_i = needs(ChannelKind::Intensity) || needs(ChannelKind::Orientation);
+        let need_i = needs(ChannelKind::Intensity) || needs(ChannelKind::Orientation) || needs(ChannelKind::Flicker);
         let need_c = needs(ChannelKind::Color);
         let weights = cfg.intensity.weights();
         if need_i || need_c {
@@ -425,6 +434,7 @@ impl SaliencyEngine {
             skin_plane(frame, cfg.color_threshold, &mut self.pyr.skin[0]);
             Self::pyramid_up(b, &mut self.pyr.skin, 0, top, &cfg.pyramid, &mut self.pyr_scratch)?;
         }
+        let need_flicker = needs(ChannelKind::Flicker);
         let base = self.used_levels.first().copied().unwrap_or(0);
         for (k, m) in external.iter().enumerate() {
             // Maps may change size between frames; the resampler follows the map's size.
@@ -437,7 +447,34 @@ impl SaliencyEngine {
             }
             Self::pyramid_up(b, &mut self.pyr.external[k], base, top, &cfg.pyramid, &mut self.pyr_scratch)?;
         }
+        if need_flicker {
+            self.flicker_levels();
+        }
         Ok(())
+    }
+
+    /// Flicker at the used levels: `|I_t - I_(t-1)|`, zero on the first frame (or after a
+    /// size change); then keeps this frame's intensity for the next.
+    fn flicker_levels(&mut self) {
+        let p = &mut self.pyr;
+        for &l in &self.used_levels {
+            let (cur, prev, out) = (&p.opp[0][l], &mut p.prev_intensity[l], &mut p.flicker[l]);
+            out.resize(cur.width(), cur.height());
+            if prev.size() == cur.size() {
+                abs_difference(cur, prev, out);
+            } else {
+                out.fill(0.0);
+            }
+            prev.resize(cur.width(), cur.height());
+            prev.copy_from(cur);
+        }
+    }
+
+    /// Forgets the previous frame, so that the next frame has no flicker (e.g. after a cut).
+    pub fn reset_temporal(&mut self) {
+        for p in &mut self.pyr.prev_intensity {
+            p.resize(0, 0);
+        }
     }
 
     fn build_orientations(&mut self) -> Result<()> {

@@ -310,3 +310,24 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn flicker_channel_responds_only_to_change() {
+    // Gravel alone, then gravel with a real patch pasted: the flicker channel alone must peak
+    // at the patch; an unchanged frame (and the first frame) gives a flat, zero map.
+    let bg = ocellus_io::read_image(data_file("gravel.png")).unwrap();
+    let bg = RgbImage::U8(Plane::from_fn(512, 512, |x, y| bg.get_f32(x, y).map(|v| (v * 255.0).round() as u8)));
+    let (with_patch, (cx, cy)) = scene_with_patch();
+    let mut cfg = SaliencyConfig::ace2009();
+    cfg.channels = vec![ChannelConfig { kind: ChannelKind::Flicker, weight: 1.0 }];
+    let mut e = SaliencyEngine::new(cfg, 512, 512).unwrap();
+    assert_eq!(e.process(&bg).unwrap().min_max(), (0.0, 0.0), "first frame: no flicker");
+    assert_eq!(e.process(&bg).unwrap().min_max(), (0.0, 0.0), "same frame: no flicker");
+    let s = e.process(&with_patch).unwrap();
+    let (mx, my) = argmax(s);
+    let (gx, gy) = ((mx as f32 + 0.5) * 16.0, (my as f32 + 0.5) * 16.0);
+    let d = ((gx - cx as f32).powi(2) + (gy - cy as f32).powi(2)).sqrt();
+    assert!(d < 48.0, "flicker peak at ({gx}, {gy}) px, change at ({cx}, {cy})");
+    e.reset_temporal();
+    assert_eq!(e.process(&with_patch).unwrap().min_max(), (0.0, 0.0), "after a reset: no flicker");
+}
