@@ -28,6 +28,7 @@ pub mod config;
 pub mod gabor;
 pub mod normalize;
 pub mod saliency;
+pub mod surprise;
 
 pub use config::SaliencyConfig;
 pub use saliency::SaliencyEngine;
