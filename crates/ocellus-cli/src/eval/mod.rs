@@ -23,9 +23,13 @@ use std::path::PathBuf;
 
 /// Blur and prior shipped as the `--center-prior` defaults: what two-fold cross-validated grid
 /// search (`ocellus eval --tune`) chose on the 100 MIT1003 images of shared/data: both folds
-/// chose weight 0.70 and sigma 0.12, and blur 0.06 and 0.08 (we ship their mean).
+/// chose skin weight 3, prior weight 0.60 and sigma 0.12, and blur 0.06 and 0.04 (we ship
+/// their mean).
 pub const DEFAULT_PRIOR: CenterPrior =
-    CenterPrior { blur_sigma_frac_width: 0.07, weight: 0.7, center_sigma_frac: 0.12 };
+    CenterPrior { blur_sigma_frac_width: 0.05, weight: 0.6, center_sigma_frac: 0.12 };
+
+/// Skin-channel weight of the `--center-prior` mode (both folds of `--tune` chose it).
+pub const DEFAULT_PRIOR_SKIN_WEIGHT: f32 = 3.0;
 
 /// The centre prior used as the IG baseline and as the `centre` model: sigma 0.25 of the larger side.
 const BASELINE_SIGMA_FRAC: f32 = 0.25;
@@ -55,14 +59,16 @@ pub struct EvalArgs {
     /// TOML file overriding fields of the `ocellus:` preset (as `ocellus saliency --config`).
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// Adds the skin-colour channel to an `ocellus:` model with this weight (0: none).
-    #[arg(long, default_value_t = 0.0)]
-    pub skin_weight: f32,
-    /// Mix in the centre prior with the shipped defaults (blur 0.07 of the width, weight 0.7,
-    /// centre sigma 0.12 of the larger side) unless --blur/--prior-weight/--prior-sigma say otherwise.
+    /// Adds the skin-colour channel to an `ocellus:` model with this weight (default 0: none;
+    /// 3 with --center-prior).
+    #[arg(long)]
+    pub skin_weight: Option<f32>,
+    /// The evaluation-friendly output: skin weight 3, blur 0.05 of the width, centre prior
+    /// weight 0.6 with sigma 0.12 of the larger side (chosen by --tune), unless
+    /// --skin-weight/--blur/--prior-weight/--prior-sigma say otherwise.
     #[arg(long)]
     pub center_prior: bool,
-    /// Gaussian blur of the map, sigma as a fraction of the image width (default 0, or 0.07 with --center-prior).
+    /// Gaussian blur of the map, sigma as a fraction of the image width (default 0, or 0.05 with --center-prior).
     #[arg(long)]
     pub blur: Option<f32>,
     /// Weight of the centre prior in [0, 1].
@@ -106,8 +112,13 @@ impl Model {
             bail!("unknown model '{}' (ocellus:ace2009, ocellus:stb, maps:DIR, centre)", a.model);
         };
         let cfg = config_file::load(preset, a.config.as_deref())?;
-        Ok(Model::Ocellus(Box::new(with_skin(&cfg, a.skin_weight)?)))
+        Ok(Model::Ocellus(Box::new(with_skin(&cfg, skin_weight(a))?)))
     }
+}
+
+/// The skin weight asked for, or the mode's default.
+fn skin_weight(a: &EvalArgs) -> f32 {
+    a.skin_weight.unwrap_or(if a.center_prior { DEFAULT_PRIOR_SKIN_WEIGHT } else { 0.0 })
 }
 
 /// `cfg` with its skin channel set to `weight` (added if missing, removed for 0).
@@ -300,7 +311,7 @@ fn write_json(
             serde_json::Value::Object(o)
         })
         .collect();
-    let doc = json!({"model": a.model, "skin_weight": a.skin_weight, "prior": prior, "images": rows});
+    let doc = json!({"model": a.model, "skin_weight": skin_weight(a), "prior": prior, "images": rows});
     std::fs::write(path, serde_json::to_string_pretty(&doc)?)
         .with_context(|| format!("cannot write {}", path.display()))?;
     println!("per-image values written to {}", path.display());
