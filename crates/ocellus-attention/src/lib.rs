@@ -21,6 +21,7 @@
 //! ```
 
 pub mod center_prior;
+pub mod chaos;
 pub mod center_surround;
 pub mod channels;
 pub mod combine;

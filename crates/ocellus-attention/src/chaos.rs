@@ -1,0 +1,190 @@
+//! Context chaos degree (seed 001, section 3.5; SPEC 2.2): how unfamiliar the current context is.
+//!
+//! From three successive grey frames `I_(k-2)`, `I_(k-1)`, `I_k`, two motion maps
+//! `M_1 = |I_(k-1) - I_(k-2)|` and `M_2 = |I_k - I_(k-1)|`; their histograms (`bins` bins
+//! over `[0, max_difference]`, larger differences in the last bin), smoothed by adding
+//! `pseudo_count` to every bin (so the divergence is always finite) and normalized; the chaos
+//! degree is the relative entropy `s = KL(h_2 || h_1)` in bits: the new motion statistics
+//! measured against the expectation set by the previous ones. The context is familiar when
+//! `s < threshold` (seed: S = 1.0).
+//!
+//! The frames may be any resolution; the saliency engine's intensity pyramid level 2 (160x120
+//! for 640x480) costs a sixteenth of full size and removes most sensor noise. Each update
+//! costs one difference and one histogram: the previous histogram is kept.
+
+use crate::{AttentionError, Result};
+use ocellus_image::Plane;
+use serde::{Deserialize, Serialize};
+
+/// Parameters of [`ChaosDegree`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ChaosConfig {
+    /// Histogram bins of the motion maps.
+    pub bins: usize,
+    /// Absolute grey difference (grey values in [0, 1]) at the top of the last bin.
+    pub max_difference: f32,
+    /// Count added to every bin before normalizing.
+    pub pseudo_count: f64,
+    /// Threshold S: the context is familiar when the chaos degree is below it.
+    pub threshold: f64,
+}
+
+impl Default for ChaosConfig {
+    fn default() -> Self {
+        Self { bins: 64, max_difference: 1.0, pseudo_count: 1.0, threshold: 1.0 }
+    }
+}
+
+impl ChaosConfig {
+    /// Checks the ranges.
+    pub fn validate(&self) -> Result<()> {
+        let ok = (2..=65_536).contains(&self.bins)
+            && self.max_difference.is_finite()
+            && self.max_difference > 0.0
+            && self.pseudo_count.is_finite()
+            && self.pseudo_count > 0.0
+            && self.threshold.is_finite();
+        if ok {
+            Ok(())
+        } else {
+            Err(AttentionError::InvalidConfig(format!(
+                "chaos {self:?}: need 2..=65536 bins, max_difference > 0, pseudo_count > 0, finite threshold"
+            )))
+        }
+    }
+}
+
+/// Chaos degree over a stream of grey frames of one size.
+#[derive(Debug)]
+pub struct ChaosDegree {
+    cfg: ChaosConfig,
+    prev: Plane<f32>,
+    /// Counts of the previous motion map, and of the current one.
+    hist_prev: Vec<f64>,
+    hist: Vec<f64>,
+    frames: usize,
+}
+
+impl ChaosDegree {
+    /// A chaos-degree tracker.
+    pub fn new(cfg: ChaosConfig) -> Result<Self> {
+        cfg.validate()?;
+        Ok(Self { hist_prev: vec![0.0; cfg.bins], hist: vec![0.0; cfg.bins], prev: Plane::default(), frames: 0, cfg })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &ChaosConfig {
+        &self.cfg
+    }
+
+    /// `true` when `s` is below the threshold S (familiar context: top-down attention).
+    pub fn is_familiar(&self, s: f64) -> bool {
+        s < self.cfg.threshold
+    }
+
+    /// Forgets the past frames.
+    pub fn reset(&mut self) {
+        self.frames = 0;
+    }
+
+    /// Adds a frame (grey, finite); returns the chaos degree in bits once three frames of the
+    /// same size have been seen, else `None`. A size change restarts the count.
+    pub fn update(&mut self, grey: &Plane<f32>) -> Result<Option<f64>> {
+        if grey.is_empty() || !grey.all_finite() {
+            return Err(AttentionError::InvalidInput("chaos degree needs a non-empty, finite frame".into()));
+        }
+        if grey.size() != self.prev.size() {
+            self.frames = 0;
+        }
+        let mut s = None;
+        if self.frames >= 1 {
+            std::mem::swap(&mut self.hist, &mut self.hist_prev);
+            motion_histogram(grey, &self.prev, self.cfg.max_difference, &mut self.hist);
+            if self.frames >= 2 {
+                s = Some(relative_entropy_bits(&self.hist, &self.hist_prev, self.cfg.pseudo_count));
+            }
+        }
+        self.prev.resize(grey.width(), grey.height());
+        self.prev.copy_from(grey);
+        self.frames += 1;
+        Ok(s)
+    }
+}
+
+/// Histogram (counts) of `|a - b|` over `out.len()` bins spanning `[0, max_difference]`;
+/// differences beyond go to the last bin. `a` and `b` have the same size.
+pub fn motion_histogram(a: &Plane<f32>, b: &Plane<f32>, max_difference: f32, out: &mut [f64]) {
+    out.iter_mut().for_each(|c| *c = 0.0);
+    let n = out.len();
+    if n == 0 {
+        return;
+    }
+    let scale = n as f32 / max_difference;
+    let last = n - 1;
+    for y in 0..a.height() {
+        for (p, q) in a.row(y).iter().zip(b.row(y)) {
+            // Counts stay exact in f64 up to 2^53 pixels.
+            out[(((p - q).abs() * scale) as usize).min(last)] += 1.0;
+        }
+    }
+}
+
+/// `KL(p || q)` in bits between two histograms of counts, each smoothed by adding `pseudo`
+/// to every bin and normalized. Finite for any counts when `pseudo > 0`.
+pub fn relative_entropy_bits(p: &[f64], q: &[f64], pseudo: f64) -> f64 {
+    let sp: f64 = p.iter().sum::<f64>() + pseudo * p.len() as f64;
+    let sq: f64 = q.iter().sum::<f64>() + pseudo * q.len() as f64;
+    let kl: f64 = p
+        .iter()
+        .zip(q)
+        .map(|(&a, &b)| {
+            let (pa, qb) = ((a + pseudo) / sp, (b + pseudo) / sq);
+            pa * (pa / qb).log2()
+        })
+        .sum();
+    kl.max(0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_entropy_matches_hand_computation() {
+        // p = (3+1, 1+1)/6 = (2/3, 1/3); q = (1+1, 3+1)/6 = (1/3, 2/3).
+        let kl = relative_entropy_bits(&[3.0, 1.0], &[1.0, 3.0], 1.0);
+        let want = 2.0 / 3.0 * 2f64.log2() + 1.0 / 3.0 * 0.5f64.log2();
+        assert!((kl - want).abs() < 1e-12);
+        assert_eq!(relative_entropy_bits(&[5.0, 0.0], &[5.0, 0.0], 1.0), 0.0);
+        assert!(relative_entropy_bits(&[0.0, 1e6], &[1e6, 0.0], 1.0).is_finite());
+    }
+
+    #[test]
+    fn histogram_bins_and_saturation() {
+        let a = Plane::from_vec(4, 1, vec![0.0, 0.3, 0.6, 1.0]).unwrap();
+        let b = Plane::new(4, 1);
+        let mut h = vec![0.0; 4];
+        motion_histogram(&a, &b, 0.5, &mut h);
+        // 0 -> bin 0, 0.3 -> bin 2, 0.6 and 1.0 saturate to bin 3.
+        assert_eq!(h, vec![1.0, 0.0, 1.0, 2.0]);
+    }
+
+    #[test]
+    fn needs_three_frames_and_flags_a_sudden_change() {
+        let mut c = ChaosDegree::new(ChaosConfig::default()).unwrap();
+        let still = Plane::from_fn(32, 32, |x, y| ((x * 7 + y * 3) % 11) as f32 / 11.0);
+        assert_eq!(c.update(&still).unwrap(), None);
+        assert_eq!(c.update(&still).unwrap(), None);
+        assert_eq!(c.update(&still).unwrap(), Some(0.0));
+        let mut changed = still.clone();
+        for y in 8..24 {
+            for x in 8..24 {
+                changed.set(x, y, 1.0 - still.get(x, y));
+            }
+        }
+        let s = c.update(&changed).unwrap().unwrap();
+        assert!(!c.is_familiar(s), "s = {s}");
+        assert!(c.update(&Plane::new(8, 8)).unwrap().is_none(), "size change restarts");
+        assert!(c.update(&Plane::from_fn(8, 8, |_, _| f32::NAN)).is_err());
+    }
+}
