@@ -2,11 +2,16 @@
 //!
 //! From three successive grey frames `I_(k-2)`, `I_(k-1)`, `I_k`, two motion maps
 //! `M_1 = |I_(k-1) - I_(k-2)|` and `M_2 = |I_k - I_(k-1)|`; their histograms (`bins` bins
-//! over `[0, max_difference]`, larger differences in the last bin), smoothed by adding
-//! `pseudo_count` to every bin (so the divergence is always finite) and normalized; the chaos
-//! degree is the relative entropy `s = KL(h_2 || h_1)` in bits: the new motion statistics
-//! measured against the expectation set by the previous ones. The context is familiar when
-//! `s < threshold` (seed: S = 1.0).
+//! over `[0, max_difference]`, larger differences in the last bin), normalized to
+//! probabilities and smoothed as `(h + eps) / (1 + bins * eps)` with `eps =
+//! empty_bin_probability` (so the divergence is always finite); the chaos degree is the
+//! relative entropy `s = KL(h_2 || h_1)` in bits: the new motion statistics measured against
+//! the expectation set by the previous ones. The context is familiar when `s < threshold`
+//! (seed: S = 1.0).
+//!
+//! What S = 1 bit means with the default `eps = 1e-9`: a fraction f of the pixels moving into
+//! bins that were empty adds about `f log2(f / (bins eps))` bits, so S is crossed when
+//! roughly 4 % of the view changes suddenly; a few noisy pixels add hundredths of a bit.
 //!
 //! The frames may be any resolution; the saliency engine's intensity pyramid level 2 (160x120
 //! for 640x480) costs a sixteenth of full size and removes most sensor noise. Each update
@@ -23,15 +28,15 @@ pub struct ChaosConfig {
     pub bins: usize,
     /// Absolute grey difference (grey values in [0, 1]) at the top of the last bin.
     pub max_difference: f32,
-    /// Count added to every bin before normalizing.
-    pub pseudo_count: f64,
+    /// Probability floor of every bin (smoothing; see the module documentation).
+    pub empty_bin_probability: f64,
     /// Threshold S: the context is familiar when the chaos degree is below it.
     pub threshold: f64,
 }
 
 impl Default for ChaosConfig {
     fn default() -> Self {
-        Self { bins: 64, max_difference: 1.0, pseudo_count: 1.0, threshold: 1.0 }
+        Self { bins: 64, max_difference: 1.0, empty_bin_probability: 1e-9, threshold: 1.0 }
     }
 }
 
@@ -41,14 +46,15 @@ impl ChaosConfig {
         let ok = (2..=65_536).contains(&self.bins)
             && self.max_difference.is_finite()
             && self.max_difference > 0.0
-            && self.pseudo_count.is_finite()
-            && self.pseudo_count > 0.0
+            && self.empty_bin_probability.is_finite()
+            && self.empty_bin_probability > 0.0
+            && self.empty_bin_probability < 0.1
             && self.threshold.is_finite();
         if ok {
             Ok(())
         } else {
             Err(AttentionError::InvalidConfig(format!(
-                "chaos {self:?}: need 2..=65536 bins, max_difference > 0, pseudo_count > 0, finite threshold"
+                "chaos {self:?}: need 2..=65536 bins, max_difference > 0, empty_bin_probability in (0, 0.1), finite threshold"
             )))
         }
     }
@@ -101,7 +107,7 @@ impl ChaosDegree {
             std::mem::swap(&mut self.hist, &mut self.hist_prev);
             motion_histogram(grey, &self.prev, self.cfg.max_difference, &mut self.hist);
             if self.frames >= 2 {
-                s = Some(relative_entropy_bits(&self.hist, &self.hist_prev, self.cfg.pseudo_count));
+                s = Some(relative_entropy_bits(&self.hist, &self.hist_prev, self.cfg.empty_bin_probability));
             }
         }
         self.prev.resize(grey.width(), grey.height());
@@ -129,16 +135,21 @@ pub fn motion_histogram(a: &Plane<f32>, b: &Plane<f32>, max_difference: f32, out
     }
 }
 
-/// `KL(p || q)` in bits between two histograms of counts, each smoothed by adding `pseudo`
-/// to every bin and normalized. Finite for any counts when `pseudo > 0`.
-pub fn relative_entropy_bits(p: &[f64], q: &[f64], pseudo: f64) -> f64 {
-    let sp: f64 = p.iter().sum::<f64>() + pseudo * p.len() as f64;
-    let sq: f64 = q.iter().sum::<f64>() + pseudo * q.len() as f64;
+/// `KL(p || q)` in bits between two histograms of counts, each normalized and smoothed as
+/// `(h / total + eps) / (1 + bins * eps)`. Finite for any counts when `eps > 0`.
+pub fn relative_entropy_bits(p: &[f64], q: &[f64], eps: f64) -> f64 {
+    let dist = |h: &[f64]| {
+        let total: f64 = h.iter().sum();
+        let inv = if total > 0.0 { 1.0 / total } else { 0.0 };
+        let norm = 1.0 + h.len() as f64 * eps;
+        move |c: f64| (c * inv + eps) / norm
+    };
+    let (dp, dq) = (dist(p), dist(q));
     let kl: f64 = p
         .iter()
         .zip(q)
         .map(|(&a, &b)| {
-            let (pa, qb) = ((a + pseudo) / sp, (b + pseudo) / sq);
+            let (pa, qb) = (dp(a), dq(b));
             pa * (pa / qb).log2()
         })
         .sum();
@@ -151,12 +162,15 @@ mod tests {
 
     #[test]
     fn relative_entropy_matches_hand_computation() {
-        // p = (3+1, 1+1)/6 = (2/3, 1/3); q = (1+1, 3+1)/6 = (1/3, 2/3).
-        let kl = relative_entropy_bits(&[3.0, 1.0], &[1.0, 3.0], 1.0);
+        // eps = 0.25: p = (3/4 + 1/4, 1/4 + 1/4) / 1.5 = (2/3, 1/3); q = (1/3, 2/3).
+        let kl = relative_entropy_bits(&[3.0, 1.0], &[1.0, 3.0], 0.25);
         let want = 2.0 / 3.0 * 2f64.log2() + 1.0 / 3.0 * 0.5f64.log2();
         assert!((kl - want).abs() < 1e-12);
-        assert_eq!(relative_entropy_bits(&[5.0, 0.0], &[5.0, 0.0], 1.0), 0.0);
-        assert!(relative_entropy_bits(&[0.0, 1e6], &[1e6, 0.0], 1.0).is_finite());
+        assert_eq!(relative_entropy_bits(&[5.0, 0.0], &[5.0, 0.0], 1e-9), 0.0);
+        // All mass moved to an empty bin: log2((1 + eps) / eps) bits, about 29.9 for 1e-9.
+        let k = relative_entropy_bits(&[0.0, 1e6], &[1e6, 0.0], 1e-9);
+        assert!((k - 29.897).abs() < 0.01, "{k}");
+        assert!(relative_entropy_bits(&[0.0, 0.0], &[1.0, 0.0], 1e-9).is_finite());
     }
 
     #[test]

@@ -200,6 +200,12 @@ pub struct SaliencyConfig {
     /// pyramid (about 1e-7) to the full range. Real contrast is far above the default 1e-5.
     #[serde(default = "default_flat_tolerance")]
     pub flat_tolerance: f32,
+    /// Flicker below this absolute intensity change (intensities in [0, 1]) counts as sensor
+    /// noise: the flicker channel uses `max(|I_t - I_(t-1)| - t, 0)` on each level. Without it,
+    /// N(.) would stretch the noise of a still scene to full range. Default 0.02 (5 grey
+    /// levels; sensor noise of 2 grey levels is far below it on levels >= 2).
+    #[serde(default = "default_flicker_threshold")]
+    pub flicker_threshold: f32,
     /// Channels and gains.
     pub channels: Vec<ChannelConfig>,
     /// Conspicuity combination rule.
@@ -218,6 +224,10 @@ impl Default for SaliencyConfig {
 
 fn default_flat_tolerance() -> f32 {
     1e-5
+}
+
+fn default_flicker_threshold() -> f32 {
+    0.02
 }
 
 fn standard_channels() -> Vec<ChannelConfig> {
@@ -264,6 +274,7 @@ impl SaliencyConfig {
             },
             feature_range: 10.0,
             flat_tolerance: default_flat_tolerance(),
+            flicker_threshold: default_flicker_threshold(),
             channels: standard_channels(),
             combination: Combination::WeightedMean,
             final_range: None,
@@ -355,6 +366,9 @@ impl SaliencyConfig {
         }
         if !(self.feature_range.is_finite() && self.feature_range > 0.0) {
             return bad(format!("feature_range = {}: must be positive", self.feature_range));
+        }
+        if !(self.flicker_threshold.is_finite() && self.flicker_threshold >= 0.0) {
+            return bad(format!("flicker_threshold = {}: must be finite and >= 0", self.flicker_threshold));
         }
         if !(self.flat_tolerance.is_finite() && self.flat_tolerance >= 0.0) {
             return bad(format!("flat_tolerance = {}: must be finite and >= 0", self.flat_tolerance));

@@ -21,9 +21,9 @@
 //! ```
 
 pub mod center_prior;
-pub mod chaos;
 pub mod center_surround;
 pub mod channels;
+pub mod chaos;
 pub mod combine;
 pub mod config;
 pub mod gabor;

@@ -453,15 +453,21 @@ impl SaliencyEngine {
         Ok(())
     }
 
-    /// Flicker at the used levels: `|I_t - I_(t-1)|`, zero on the first frame (or after a
-    /// size change); then keeps this frame's intensity for the next.
+    /// Flicker at the used levels: `max(|I_t - I_(t-1)| - threshold, 0)`, zero on the first
+    /// frame (or after a size change); then keeps this frame's intensity for the next.
     fn flicker_levels(&mut self) {
         let p = &mut self.pyr;
+        let t = self.cfg.flicker_threshold;
         for &l in &self.used_levels {
             let (cur, prev, out) = (&p.opp[0][l], &mut p.prev_intensity[l], &mut p.flicker[l]);
             out.resize(cur.width(), cur.height());
             if prev.size() == cur.size() {
-                abs_difference(cur, prev, out);
+                for y in 0..cur.height() {
+                    let (c, q) = (cur.row(y), prev.row(y));
+                    for (x, o) in out.row_mut(y).iter_mut().enumerate() {
+                        *o = ((c[x] - q[x]).abs() - t).max(0.0);
+                    }
+                }
             } else {
                 out.fill(0.0);
             }

@@ -15,7 +15,6 @@
 //! ```
 
 pub mod metrics;
-mod rng;
 
 use thiserror::Error;
 

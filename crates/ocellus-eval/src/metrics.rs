@@ -5,8 +5,8 @@
 //! All maps must have the same size (resample saliency maps to the fixation map's size first).
 //! Fixations are (x, y) pixel positions; duplicates count once, as in a binary fixation map.
 
-use crate::rng::SplitMix64;
 use crate::{EvalError, Result};
+use ocellus_image::rng::SplitMix64;
 use ocellus_image::Plane;
 
 /// The benchmark's epsilon (MATLAB's `eps`).

@@ -22,6 +22,7 @@ mod plane;
 pub mod preserving;
 pub mod pyramid;
 pub mod resample;
+pub mod rng;
 pub mod simd;
 
 pub use error::{ImageError, Result};
