@@ -349,9 +349,9 @@ mod tests {
         let world = RgbImage::U8(Plane::from_fn(20, 20, |_, _| [0, 0, 0]));
         let mut c = SceneConfig::new(Scenario::SuddenObject);
         c.object_at = (600, 400);
-        assert!(SceneGenerator::new(c, &[world.clone()], &world).is_err());
+        assert!(SceneGenerator::new(c, std::slice::from_ref(&world), &world).is_err());
         assert!(SceneGenerator::new(SceneConfig::new(Scenario::Static), &[], &world).is_err());
         let c = SceneConfig { frames: 0, ..SceneConfig::new(Scenario::Static) };
-        assert!(SceneGenerator::new(c, &[world.clone()], &world).is_err());
+        assert!(SceneGenerator::new(c, std::slice::from_ref(&world), &world).is_err());
     }
 }
