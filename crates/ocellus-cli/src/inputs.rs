@@ -3,40 +3,7 @@
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 
-/// Compares file names with runs of digits as numbers ("frame2" < "frame10").
-pub fn natural_cmp(a: &str, b: &str) -> std::cmp::Ordering {
-    let (mut ai, mut bi) = (a.chars().peekable(), b.chars().peekable());
-    loop {
-        match (ai.peek().copied(), bi.peek().copied()) {
-            (None, None) => return std::cmp::Ordering::Equal,
-            (None, _) => return std::cmp::Ordering::Less,
-            (_, None) => return std::cmp::Ordering::Greater,
-            (Some(x), Some(y)) if x.is_ascii_digit() && y.is_ascii_digit() => {
-                let take = |it: &mut std::iter::Peekable<std::str::Chars>| {
-                    let mut s = String::new();
-                    while let Some(c) = it.peek().copied().filter(char::is_ascii_digit) {
-                        s.push(c);
-                        it.next();
-                    }
-                    s
-                };
-                let (na, nb) = (take(&mut ai), take(&mut bi));
-                let (ta, tb) = (na.trim_start_matches('0'), nb.trim_start_matches('0'));
-                let o = ta.len().cmp(&tb.len()).then_with(|| ta.cmp(tb)).then_with(|| na.len().cmp(&nb.len()));
-                if o.is_ne() {
-                    return o;
-                }
-            }
-            (Some(x), Some(y)) => {
-                if x != y {
-                    return x.cmp(&y);
-                }
-                ai.next();
-                bi.next();
-            }
-        }
-    }
-}
+pub use ocellus_io::video::natural_cmp;
 
 /// Files as given, folders expanded to their image files in natural order.
 pub fn collect_images(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
@@ -66,15 +33,4 @@ pub fn collect_images(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
 /// File stem for output names ("img" for "dir/img.png").
 pub fn stem(p: &Path) -> String {
     p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "image".into())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    #[test]
-    fn natural_order() {
-        let mut v = vec!["f10.png", "f2.png", "f1.png", "f02.png", "g.png"];
-        v.sort_by(|a, b| natural_cmp(a, b));
-        assert_eq!(v, vec!["f1.png", "f2.png", "f02.png", "f10.png", "g.png"]);
-    }
 }

@@ -5,6 +5,8 @@
 //! - [`npy`]: NumPy `.npy` arrays (read f32/f64 in C or Fortran order; write f32, C order).
 //! - [`pfm`]: Portable Float Map, single channel, as Middlebury writes it (rows bottom-up).
 //! - [`points`]: CSV files of 2D points (fixations), in pixels.
+//! - [`video`]: frame sources (image folders, Y4M, any video through the ffmpeg program) and
+//!   [`y4m`] reading and writing.
 //!
 //! ```
 //! use ocellus_image::Plane;
@@ -20,6 +22,8 @@
 pub mod npy;
 pub mod pfm;
 pub mod points;
+pub mod video;
+pub mod y4m;
 
 use ocellus_image::convert::{from_dynamic, RgbImage};
 use std::path::{Path, PathBuf};
@@ -62,6 +66,19 @@ pub enum IoError {
         /// What the decoder said.
         reason: String,
     },
+    /// A video or frame sequence failed at a frame (the frames before it were delivered).
+    #[error("{path}: frame {frame}: {reason}")]
+    Video {
+        /// The video or folder.
+        path: PathBuf,
+        /// Index of the frame that failed (0-based).
+        frame: usize,
+        /// What went wrong.
+        reason: String,
+    },
+    /// The ffmpeg program is missing or failed to start.
+    #[error("{0}")]
+    Ffmpeg(String),
     /// The content is valid but unusable (zero size, wrong shape, ...).
     #[error("{path}: {reason}")]
     Invalid {
@@ -70,6 +87,16 @@ pub enum IoError {
         /// Why.
         reason: String,
     },
+}
+
+impl IoError {
+    /// The frame a video error happened at, if it is one.
+    pub fn frame(&self) -> Option<usize> {
+        match self {
+            IoError::Video { frame, .. } => Some(*frame),
+            _ => None,
+        }
+    }
 }
 
 /// Result type of this crate.
