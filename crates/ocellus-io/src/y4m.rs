@@ -114,11 +114,7 @@ fn parse_header(line: &[u8], path: &Path) -> Result<Y4mHeader> {
                     }
                 }
             }
-            "X" => {
-                if val.eq_ignore_ascii_case("COLORRANGE=FULL") {
-                    h.full_range = true;
-                }
-            }
+            "X" if val.eq_ignore_ascii_case("COLORRANGE=FULL") => h.full_range = true,
             _ => {} // interlacing, aspect ratio, comments: not needed for RGB frames
         }
     }
