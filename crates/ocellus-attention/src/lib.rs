@@ -20,12 +20,14 @@
 //! assert!(map.all_finite());
 //! ```
 
+pub mod attention;
 pub mod center_prior;
 pub mod center_surround;
 pub mod channels;
 pub mod chaos;
 pub mod combine;
 pub mod config;
+pub mod egosphere;
 pub mod gabor;
 pub mod normalize;
 pub mod saliency;

@@ -91,3 +91,82 @@ fn surprise_peaks_where_and_when_the_object_appears() {
     );
     assert!(event[ev].surprise_max > 10.0 * static_max, "event {} vs static {static_max}", event[ev].surprise_max);
 }
+
+/// Saccades over a panning sequence, in world angles: (frame, azimuth, elevation, the world
+/// inhibition at the target when it was chosen). `use_pan = false` feeds the attention a still
+/// camera although it pans (the control without an ego-sphere). Inhibition is recomputed in
+/// the world frame from the inhibition-of-return events of the run, identically for both.
+fn pan_scanpath(use_pan: bool) -> (Vec<(usize, f32, f32, f32)>, usize) {
+    use ocellus_attention::attention::{Attention, AttentionConfig};
+    use ocellus_attention::egosphere::{separation_deg, ViewGeometry};
+    let world: Vec<_> = ["coffee.png", "rocket.jpg", "astronaut.png"]
+        .iter()
+        .map(|n| ocellus_io::read_image(data_file(n)).unwrap())
+        .collect();
+    let object = ocellus_io::read_image(data_file("chelsea.png")).unwrap();
+    let cfg = SceneConfig { frames: 90, pan_px_per_frame: 4.0, ..SceneConfig::new(Scenario::Pan) };
+    let g = SceneGenerator::new(cfg, &world, &object).unwrap();
+    let mut engine = SaliencyEngine::new(SaliencyConfig::ace2009(), 640, 480).unwrap();
+    let view = ViewGeometry { width: 640, height: 480, deg_per_px: g.config().deg_per_px };
+    let acfg = AttentionConfig::default();
+    let (tau, sigma) = (acfg.ior_tau_frames, acfg.ior_sigma_deg);
+    let mut a = Attention::new(acfg, view).unwrap();
+    let mut saccades = Vec::new();
+    // Longest stay of the gaze within 2.5 degrees of one world point, frames.
+    let (mut dwell_start, mut dwell, mut longest) = ((f32::NAN, f32::NAN), 0usize, 0usize);
+    // Inhibition-of-return events in world angles: (frame, azimuth, elevation, amount).
+    let mut events: Vec<(usize, f32, f32, f32)> = Vec::new();
+    let world_ior = |events: &[(usize, f32, f32, f32)], k: usize, az: f32, el: f32| -> f32 {
+        let v: f32 = events
+            .iter()
+            .map(|&(j, eaz, eel, amt)| {
+                let d = separation_deg((az, el), (eaz, eel));
+                amt * (-((k - j) as f32) / tau).exp() * (-0.5 * d * d / (sigma * sigma)).exp()
+            })
+            .sum();
+        v.min(1.0)
+    };
+    for k in 0..g.len() {
+        let (frame, truth) = g.frame(k).unwrap();
+        let s = engine.process(&frame).unwrap();
+        let pan = if use_pan { truth.pan_deg } else { 0.0 };
+        let shift = truth.pan_deg - pan; // camera-frame angles + shift = world angles
+        let before: f32 = a.inhibition_of_return().blobs.iter().map(|b| b.amplitude).sum();
+        let f = a.step(s, None, pan, 0.0).unwrap().unwrap();
+        let (az, el) = (f.azimuth_deg + shift, f.elevation_deg);
+        if f.saccade {
+            saccades.push((k, az, el, world_ior(&events, k, az, el)));
+        }
+        if separation_deg((az, el), dwell_start) <= 2.5 {
+            dwell += 1;
+        } else {
+            (dwell_start, dwell) = ((az, el), 1);
+        }
+        longest = longest.max(dwell);
+        let after: f32 = a.inhibition_of_return().blobs.iter().map(|b| b.amplitude).sum();
+        let decayed = before * (-1.0 / tau).exp();
+        if after > decayed + 0.5 {
+            events.push((k, az, el, after - decayed));
+        }
+    }
+    (saccades, longest)
+}
+
+#[test]
+fn egosphere_keeps_attended_world_points_inhibited_during_a_pan() {
+    let ((with, dwell_with), (without, dwell_without)) = (pan_scanpath(true), pan_scanpath(false));
+    let fmt = |v: &[(usize, f32, f32, f32)]| {
+        v.iter().map(|s| format!("f{} ({:.1},{:.1}) ior {:.2}", s.0, s.1, s.2, s.3)).collect::<Vec<_>>().join("; ")
+    };
+    println!("with ego-sphere (longest dwell {dwell_with} frames): {}", fmt(&with));
+    println!("without (longest dwell {dwell_without} frames): {}", fmt(&without));
+    assert!(with.len() >= 4, "the gaze moves on: {}", fmt(&with));
+    // A fresh inhibition blob is 1 and decays with tau = 90 frames; 0.75 means inhibited
+    // within the last 26 frames. (Older, weaker inhibition can lose to a strong stimulus.)
+    let worst = with.iter().map(|s| s.3).fold(0.0f32, f32::max);
+    assert!(worst < 0.75, "a saccade went to a world point still inhibited at {worst}");
+    // Habituation moves the gaze on after about 14 frames on one place; without the
+    // ego-sphere the inhibition slides away with the image and the gaze stays on one world point.
+    assert!(dwell_with <= 30, "with ego-sphere the gaze dwelt {dwell_with} frames on one place");
+    assert!(dwell_without > 2 * dwell_with, "control dwelt {dwell_without} frames");
+}
