@@ -145,7 +145,7 @@ pub struct Attention {
 fn argmax(values: impl Iterator<Item = f32>) -> Option<(usize, f32)> {
     let mut best: Option<(usize, f32)> = None;
     for (i, v) in values.enumerate() {
-        if v > 0.0 && best.is_none_or(|(_, b)| v > b) {
+        if v > 0.0 && !matches!(best, Some((_, b)) if v <= b) {
             best = Some((i, v));
         }
     }
@@ -258,8 +258,9 @@ impl Attention {
         let (x, y) = pixel(i);
         let (az, el) = self.view.direction(x, y, pan_deg, tilt_deg);
         let c = &self.cfg;
-        let saccade =
-            self.current.is_none_or(|f| separation_deg((az, el), (f.azimuth_deg, f.elevation_deg)) > c.min_saccade_deg);
+        let saccade = self
+            .current
+            .map_or(true, |f| separation_deg((az, el), (f.azimuth_deg, f.elevation_deg)) > c.min_saccade_deg);
         // Neighbouring map cells of one object share a habituation blob.
         self.habituation.add(az, el, c.habituation_gain, c.habituation_sigma_deg, c.habituation_sigma_deg);
         if self.habituation.value(az, el) >= c.habituation_threshold {
