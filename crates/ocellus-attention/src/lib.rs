@@ -31,6 +31,7 @@ pub mod egosphere;
 pub mod gabor;
 pub mod normalize;
 pub mod saliency;
+pub mod stream;
 pub mod surprise;
 
 pub use config::SaliencyConfig;

@@ -279,6 +279,11 @@ impl SaliencyEngine {
         (self.width, self.height)
     }
 
+    /// Size (width, height) of every pyramid level, level 0 first.
+    pub fn level_sizes(&self) -> &[(usize, usize)] {
+        &self.sizes
+    }
+
     /// Size (width, height) of the feature, conspicuity and saliency maps.
     pub fn map_size(&self) -> (usize, usize) {
         self.sizes[self.cfg.map_level]

@@ -1,13 +1,19 @@
 //! `ocellus`: the command-line program of the ocellus active-vision toolkit.
 
 mod assets;
+mod attend;
 mod bench;
 mod config_file;
 mod demo;
 mod eval;
+mod frames;
+mod generate;
 mod inputs;
 mod overlay;
+mod plot;
 mod saliency_cmd;
+mod surprise_cmd;
+mod video_out;
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -17,7 +23,7 @@ use clap::{Parser, Subcommand};
 #[command(
     name = "ocellus",
     version,
-    about = "Fast, biologically inspired active vision for robots: saliency (where to look), and more to come",
+    about = "Fast, biologically inspired active vision for robots: saliency, surprise and attention (where to look), and more to come",
     long_about = None
 )]
 struct Cli {
@@ -33,6 +39,14 @@ enum Command {
     Saliency(saliency_cmd::SaliencyArgs),
     /// Score saliency maps against human fixation maps (CC, SIM, KL; MIT benchmark definitions).
     Eval(eval::EvalArgs),
+    /// Attention over a video or image sequence: saliency with flicker, surprise, context
+    /// chaos, winner-take-all with inhibition of return on an ego-sphere; writes overlays, a
+    /// video, the scanpath and per-frame context values with a plot.
+    Attend(attend::AttendArgs),
+    /// Bayesian surprise maps (bits) of a video or image sequence, and the per-frame maximum.
+    Surprise(surprise_cmd::SurpriseArgs),
+    /// Generate ground-truth sequences from the built-in real images.
+    Generate(generate::GenerateArgs),
     /// Print benchmark figures (median ms per frame, fps on all cores, per stage, peak memory).
     Bench(bench::BenchArgs),
 }
@@ -44,6 +58,9 @@ fn main() {
         Command::Saliency(a) => saliency_cmd::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Eval(a) => eval::run(a),
+        Command::Attend(a) => attend::run(a),
+        Command::Surprise(a) => surprise_cmd::run(a),
+        Command::Generate(a) => generate::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

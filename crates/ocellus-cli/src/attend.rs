@@ -1,0 +1,235 @@
+//! `ocellus attend`: saliency, surprise, context chaos and attention over a video or image
+//! sequence, with overlays, a scanpath and per-frame context values.
+
+use crate::{config_file, frames, overlay, plot, video_out::VideoWriter};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use ocellus_attention::attention::{Fixation, Reason};
+use ocellus_attention::stream::{StreamConfig, StreamEngine, StreamFrame};
+use ocellus_attention::surprise::SurpriseConfig;
+use ocellus_image::convert::{to_image_rgb8, RgbImage};
+use ocellus_image::Plane;
+use plotters::style::RGBColor;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `ocellus attend`.
+#[derive(Args, Debug)]
+pub struct AttendArgs {
+    /// A video file (anything ffmpeg reads; .y4m natively) or a folder of images (natural order).
+    pub input: PathBuf,
+    /// CSV of the camera's pan and tilt per frame (`frame,pan_deg,tilt_deg`, degrees, positive
+    /// right and down) for the ego-sphere; without it the camera is taken as still.
+    #[arg(long)]
+    pub pan_tilt: Option<PathBuf>,
+    /// Camera angle per pixel in degrees (0.1: 64 degrees across 640 pixels).
+    #[arg(long, default_value_t = 0.1)]
+    pub deg_per_px: f32,
+    /// Output folder.
+    #[arg(long, default_value = "ocellus-attend")]
+    pub out: PathBuf,
+    /// Saliency preset (ace2009 or stb); a flicker channel is added.
+    #[arg(long, default_value = "ace2009")]
+    pub preset: String,
+    /// TOML file overriding preset fields (as `ocellus saliency --config`).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Use the 5-model multi-timescale surprise (iLab) instead of the single model.
+    #[arg(long)]
+    pub surprise_chain: bool,
+    /// Do not write per-frame overlay PNGs (the video, CSVs and plot are still written).
+    #[arg(long)]
+    pub no_overlays: bool,
+    /// Frame rate of the overlay video.
+    #[arg(long, default_value_t = 30)]
+    pub fps: u32,
+    /// Process at most N frames.
+    #[arg(long)]
+    pub limit: Option<usize>,
+}
+
+/// Where per-frame results go.
+struct Outputs {
+    dir: PathBuf,
+    overlays: bool,
+    video: Option<VideoWriter>,
+    scanpath: std::io::BufWriter<std::fs::File>,
+    context: std::io::BufWriter<std::fs::File>,
+    chaos: Vec<(f64, f64)>,
+    surprise_max: Vec<(f64, f64)>,
+    recent: Vec<Fixation>,
+    saccades: usize,
+}
+
+fn create(dir: &Path, name: &str) -> Result<std::io::BufWriter<std::fs::File>> {
+    let p = dir.join(name);
+    Ok(std::io::BufWriter::new(std::fs::File::create(&p).with_context(|| format!("cannot create {}", p.display()))?))
+}
+
+impl Outputs {
+    fn new(dir: &Path, overlays: bool) -> Result<Self> {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        if overlays {
+            std::fs::create_dir_all(dir.join("overlays"))?;
+        }
+        let mut scanpath = create(dir, "scanpath.csv")?;
+        writeln!(scanpath, "frame,x,y,azimuth_deg,elevation_deg,reason")?;
+        let mut context = create(dir, "context.csv")?;
+        writeln!(
+            context,
+            "frame,chaos_bits,familiar,surprise_max_bits,fixation_x,fixation_y,reason,saliency_ms,temporal_us"
+        )?;
+        Ok(Self {
+            dir: dir.into(),
+            overlays,
+            video: None,
+            scanpath,
+            context,
+            chaos: Vec::new(),
+            surprise_max: Vec::new(),
+            recent: Vec::new(),
+            saccades: 0,
+        })
+    }
+
+    fn record(&mut self, frame: &RgbImage, r: &StreamFrame, fps: u32) -> Result<()> {
+        let k = r.frame;
+        let smax = r.surprise.min_max().1;
+        let (fx, fy, reason) = match r.fixation {
+            Some(f) => (format!("{:.1}", f.x), format!("{:.1}", f.y), f.reason.as_str()),
+            None => (String::new(), String::new(), ""),
+        };
+        let chaos = r.chaos.map(|c| format!("{c:.5}")).unwrap_or_default();
+        writeln!(
+            self.context,
+            "{k},{chaos},{},{smax:.4},{fx},{fy},{reason},{:.3},{:.1}",
+            u8::from(r.familiar),
+            r.saliency_time.as_secs_f64() * 1e3,
+            r.temporal_time.as_secs_f64() * 1e6
+        )?;
+        if let Some(c) = r.chaos {
+            self.chaos.push((k as f64, c));
+        }
+        self.surprise_max.push((k as f64, smax as f64));
+        if let Some(f) = r.fixation.filter(|f| f.saccade) {
+            writeln!(
+                self.scanpath,
+                "{k},{:.1},{:.1},{:.3},{:.3},{}",
+                f.x,
+                f.y,
+                f.azimuth_deg,
+                f.elevation_deg,
+                f.reason.as_str()
+            )?;
+            self.saccades += 1;
+            self.recent.push(f);
+            if self.recent.len() > 8 {
+                self.recent.remove(0);
+            }
+        }
+        let img = composite(frame, r, &self.recent)?;
+        if self.overlays {
+            let p = self.dir.join("overlays").join(format!("frame_{k:05}.png"));
+            ocellus_io::write_png(&p, &to_image_rgb8(&img))?;
+        }
+        if k == 0 {
+            self.video = VideoWriter::start(&self.dir.join("overlays.mp4"), img.width(), img.height(), fps)?;
+            if self.video.is_none() {
+                eprintln!("note: ffmpeg not found; no overlays.mp4 (scripts/setup.sh installs it)");
+            }
+        }
+        if let Some(v) = self.video.as_mut() {
+            v.write(&img)?;
+        }
+        Ok(())
+    }
+
+    /// Flushes the CSVs, closes the video and draws the plot; returns what was written.
+    fn finish(mut self, threshold: f64) -> Result<Vec<String>> {
+        self.scanpath.flush()?;
+        self.context.flush()?;
+        let mut written = vec!["scanpath.csv".to_string(), "context.csv".into()];
+        if let Some(v) = self.video.take() {
+            v.finish()?;
+            written.push("overlays.mp4".into());
+        }
+        if self.overlays {
+            written.push("overlays/".into());
+        }
+        plot::line_plot(
+            &self.dir.join("context.png"),
+            "context chaos degree and surprise per frame",
+            "bits",
+            &[
+                plot::Series { label: "chaos degree s", points: self.chaos, color: RGBColor(200, 40, 40) },
+                plot::Series { label: "max surprise", points: self.surprise_max, color: RGBColor(30, 90, 200) },
+            ],
+            Some((threshold, "threshold S")),
+        )?;
+        written.push("context.png".into());
+        Ok(written)
+    }
+}
+
+/// The overlay image: [frame with fixations | saliency] over [surprise | inhibition], each
+/// panel at half the frame size (even sizes, for video).
+fn composite(frame: &RgbImage, r: &StreamFrame, recent: &[Fixation]) -> Result<Plane<[u8; 3]>> {
+    let px = frame.to_u8();
+    let mut half = overlay::half_size(&px);
+    let (w, h) = (half.width() & !1, half.height() & !1);
+    half = Plane::from_fn(w.max(2), h.max(2), |x, y| half.get(x.min(half.width() - 1), y.min(half.height() - 1)));
+    let sal = overlay::overlay_scaled(&half, r.saliency, 0.0)?;
+    // Surprise on a fixed scale up to 10 bits, so quiet frames look quiet.
+    let sur = overlay::overlay_scaled(&half, r.surprise, 10.0)?;
+    let inh = overlay::overlay_scaled(&half, r.inhibition, 1.0)?;
+    let mut view = half.clone();
+    for f in recent {
+        overlay::draw_ring(&mut view, f.x / 2.0, f.y / 2.0, 6.0, [255, 255, 255]);
+    }
+    if let Some(f) = r.fixation {
+        let color = match f.reason {
+            Reason::Salient => [40, 230, 60],
+            Reason::Surprising => [250, 40, 40],
+        };
+        overlay::draw_ring(&mut view, f.x / 2.0, f.y / 2.0, 14.0, color);
+    }
+    Ok(overlay::grid2x2([&view, &sal, &sur, &inh]))
+}
+
+/// The stream configuration of `attend` and `surprise`.
+pub fn stream_config(preset: &str, config: Option<&Path>, chain: bool, deg_per_px: f32) -> Result<StreamConfig> {
+    Ok(StreamConfig {
+        saliency: config_file::load(preset, config)?,
+        surprise: if chain { SurpriseConfig::chain() } else { SurpriseConfig::default() },
+        deg_per_px,
+        ..StreamConfig::default()
+    })
+}
+
+/// Runs the subcommand.
+pub fn run(a: AttendArgs) -> Result<()> {
+    let cfg = stream_config(&a.preset, a.config.as_deref(), a.surprise_chain, a.deg_per_px)?;
+    let pan_tilt = a.pan_tilt.as_deref().map(frames::read_pan_tilt).transpose()?;
+    let mut out = Outputs::new(&a.out, !a.no_overlays)?;
+    let mut engine: Option<StreamEngine> = None;
+    let threshold = cfg.chaos.threshold;
+    let result = frames::for_each_frame(&a.input, a.limit, |k, frame| {
+        let (w, h) = frame.size();
+        if engine.is_none() {
+            engine = Some(StreamEngine::new(cfg.clone(), w, h)?);
+        }
+        let Some(e) = engine.as_mut() else { bail!("no engine") };
+        let (pan, tilt) = match &pan_tilt {
+            Some(v) => *v.get(k).with_context(|| format!("the pan-tilt CSV has no row for frame {k}"))?,
+            None => (0.0, 0.0),
+        };
+        let r = e.process(frame, pan, tilt)?;
+        out.record(frame, &r, a.fps)
+    });
+    // Whatever happened, what was processed is written out.
+    let saccades = out.saccades;
+    let written = out.finish(threshold)?;
+    let n = result?;
+    println!("{n} frames, {saccades} saccades; wrote {} in {}", written.join(", "), a.out.display());
+    Ok(())
+}

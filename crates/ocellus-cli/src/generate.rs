@@ -1,0 +1,132 @@
+//! `ocellus generate`: ground-truth sequences built from the built-in real images.
+
+use crate::assets;
+use anyhow::{Context, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use ocellus_image::convert::{to_image_rgb8, RgbImage};
+use ocellus_io::y4m::Y4mWriter;
+use ocellus_synth::attention_scenes::{Scenario, SceneConfig, SceneGenerator};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `ocellus generate`.
+#[derive(Args, Debug)]
+pub struct GenerateArgs {
+    #[command(subcommand)]
+    what: What,
+}
+
+#[derive(Subcommand, Debug)]
+enum What {
+    /// Sequences for surprise, context chaos and attention: a still scene with sensor noise, an
+    /// object appearing suddenly, or a steady camera pan, over a panorama of the built-in photos.
+    Attention(AttentionArgs),
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum ScenarioArg {
+    Static,
+    Sudden,
+    Pan,
+}
+
+#[derive(Args, Debug)]
+struct AttentionArgs {
+    /// What happens.
+    #[arg(long, value_enum, default_value = "sudden")]
+    scenario: ScenarioArg,
+    /// Output folder: frames/frame_NNNNN.png (or sequence.y4m), truth.csv, pan_tilt.csv.
+    #[arg(long, default_value = "ocellus-sequence")]
+    out: PathBuf,
+    /// Number of frames.
+    #[arg(long, default_value_t = 30)]
+    frames: usize,
+    /// First frame showing the object (sudden).
+    #[arg(long, default_value_t = 15)]
+    event_frame: usize,
+    /// Seed of the sensor noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Sensor noise, standard deviation in grey levels.
+    #[arg(long, default_value_t = 2.0)]
+    noise: f32,
+    /// Pan speed, pixels per frame (pan).
+    #[arg(long, default_value_t = 6.0)]
+    pan_px_per_frame: f32,
+    /// Write one Y4M video instead of PNG frames.
+    #[arg(long)]
+    y4m: bool,
+}
+
+/// Coffee, rocket and astronaut side by side as the world; the cat as the sudden object.
+pub fn scene(cfg: SceneConfig) -> Result<SceneGenerator> {
+    let img = |name: &str| -> Result<RgbImage> {
+        let bytes = assets::IMAGES.iter().find(|(n, _)| *n == name).map(|(_, b)| *b).context("missing asset")?;
+        Ok(ocellus_io::decode_image(bytes, Path::new(name))?)
+    };
+    let world = [img("coffee.png")?, img("rocket.jpg")?, img("astronaut.png")?];
+    Ok(SceneGenerator::new(cfg, &world, &img("chelsea.png")?)?)
+}
+
+/// Runs the subcommand.
+pub fn run(a: GenerateArgs) -> Result<()> {
+    let What::Attention(a) = a.what;
+    let scenario = match a.scenario {
+        ScenarioArg::Static => Scenario::Static,
+        ScenarioArg::Sudden => Scenario::SuddenObject,
+        ScenarioArg::Pan => Scenario::Pan,
+    };
+    let cfg = SceneConfig {
+        frames: a.frames,
+        event_frame: a.event_frame,
+        seed: a.seed,
+        noise_sigma: a.noise,
+        pan_px_per_frame: a.pan_px_per_frame,
+        ..SceneConfig::new(scenario)
+    };
+    let g = scene(cfg)?;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    let create = |name: &str| -> Result<std::io::BufWriter<std::fs::File>> {
+        let p = a.out.join(name);
+        Ok(std::io::BufWriter::new(
+            std::fs::File::create(&p).with_context(|| format!("cannot create {}", p.display()))?,
+        ))
+    };
+    let mut truth = create("truth.csv")?;
+    writeln!(truth, "frame,pan_deg,tilt_deg,object_x,object_y,object_w,object_h,event")?;
+    let mut pan_tilt = create("pan_tilt.csv")?;
+    writeln!(pan_tilt, "frame,pan_deg,tilt_deg")?;
+    let c = g.config();
+    let mut y4m = if a.y4m { Some(Y4mWriter::new(create("sequence.y4m")?, c.width, c.height, (30, 1))?) } else { None };
+    let frames_dir = a.out.join("frames");
+    if !a.y4m {
+        std::fs::create_dir_all(&frames_dir)?;
+    }
+    for k in 0..g.len() {
+        let (frame, t) = g.frame(k)?;
+        match &mut y4m {
+            Some(w) => w.write_frame(&frame)?,
+            None => {
+                ocellus_io::write_png(frames_dir.join(format!("frame_{k:05}.png")), &to_image_rgb8(&frame.to_u8()))?
+            }
+        }
+        let o = t.object.map(|r| format!("{},{},{},{}", r.x, r.y, r.w, r.h)).unwrap_or_else(|| ",,,".into());
+        writeln!(truth, "{k},{:.4},{:.4},{o},{}", t.pan_deg, t.tilt_deg, u8::from(t.event))?;
+        writeln!(pan_tilt, "{k},{:.4},{:.4}", t.pan_deg, t.tilt_deg)?;
+    }
+    if let Some(w) = y4m {
+        w.finish()?;
+    }
+    truth.flush()?;
+    pan_tilt.flush()?;
+    println!(
+        "{} frames {}x{} ({:?}) written to {} ({}), with truth.csv and pan_tilt.csv",
+        g.len(),
+        c.width,
+        c.height,
+        scenario,
+        a.out.display(),
+        if a.y4m { "sequence.y4m" } else { "frames/" }
+    );
+    Ok(())
+}

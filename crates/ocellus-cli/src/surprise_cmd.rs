@@ -1,0 +1,89 @@
+//! `ocellus surprise`: Bayesian surprise maps of a video or image sequence.
+
+use crate::attend::stream_config;
+use crate::{frames, overlay};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use ocellus_attention::stream::StreamEngine;
+use ocellus_image::convert::to_image_rgb8;
+use std::io::Write;
+use std::path::PathBuf;
+
+/// Arguments of `ocellus surprise`.
+#[derive(Args, Debug)]
+pub struct SurpriseArgs {
+    /// A video file (anything ffmpeg reads; .y4m natively) or a folder of images.
+    pub input: PathBuf,
+    /// Output folder: surprise/frame_NNNNN.png (and .npy with --npy), surprise.csv.
+    #[arg(long, default_value = "ocellus-surprise")]
+    pub out: PathBuf,
+    /// Saliency preset (ace2009 or stb); a flicker channel is added.
+    #[arg(long, default_value = "ace2009")]
+    pub preset: String,
+    /// TOML file overriding preset fields.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Use the 5-model multi-timescale surprise (iLab) instead of the single model.
+    #[arg(long)]
+    pub chain: bool,
+    /// Also write each surprise map (bits, map level) as NumPy .npy.
+    #[arg(long)]
+    pub npy: bool,
+    /// Process at most N frames.
+    #[arg(long)]
+    pub limit: Option<usize>,
+}
+
+/// Runs the subcommand.
+pub fn run(a: SurpriseArgs) -> Result<()> {
+    let cfg = stream_config(&a.preset, a.config.as_deref(), a.chain, 0.1)?;
+    let maps = a.out.join("surprise");
+    std::fs::create_dir_all(&maps).with_context(|| format!("cannot create {}", maps.display()))?;
+    let csv_path = a.out.join("surprise.csv");
+    let mut csv = std::io::BufWriter::new(
+        std::fs::File::create(&csv_path).with_context(|| format!("cannot create {}", csv_path.display()))?,
+    );
+    writeln!(csv, "frame,surprise_max_bits,x,y,chaos_bits")?;
+    let mut engine: Option<StreamEngine> = None;
+    let mut peak = (0.0f32, 0usize);
+    let result = frames::for_each_frame(&a.input, a.limit, |k, frame| {
+        let (w, h) = frame.size();
+        if engine.is_none() {
+            engine = Some(StreamEngine::new(cfg.clone(), w, h)?);
+        }
+        let Some(e) = engine.as_mut() else { bail!("no engine") };
+        let r = e.process(frame, 0.0, 0.0)?;
+        let m = r.surprise;
+        let (mut best, mut at) = (f32::MIN, (0, 0));
+        for y in 0..m.height() {
+            for (x, &v) in m.row(y).iter().enumerate() {
+                if v > best {
+                    (best, at) = (v, (x, y));
+                }
+            }
+        }
+        // Cell centre in frame pixels.
+        let (sx, sy) = (w as f32 / m.width() as f32, h as f32 / m.height() as f32);
+        let (px, py) = ((at.0 as f32 + 0.5) * sx - 0.5, (at.1 as f32 + 0.5) * sy - 0.5);
+        let chaos = r.chaos.map(|c| format!("{c:.5}")).unwrap_or_default();
+        writeln!(csv, "{k},{best:.4},{px:.1},{py:.1},{chaos}")?;
+        if best > peak.0 {
+            peak = (best, k);
+        }
+        let img = overlay::overlay_scaled(&overlay::half_size(&frame.to_u8()), m, 10.0)?;
+        ocellus_io::write_png(maps.join(format!("frame_{k:05}.png")), &to_image_rgb8(&img))?;
+        if a.npy {
+            ocellus_io::npy::write_plane(maps.join(format!("frame_{k:05}.npy")), m)?;
+        }
+        Ok(())
+    });
+    csv.flush()?;
+    let n = result?;
+    println!(
+        "{n} frames; largest surprise {:.2} bits at frame {}; wrote surprise/ and surprise.csv in {}",
+        peak.0,
+        peak.1,
+        a.out.display()
+    );
+    Ok(())
+}
