@@ -32,18 +32,6 @@ fn overlay_with_scale(img: &Plane<[u8; 3]>, map: &Plane<f32>, s: f32) -> Plane<[
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    #[test]
-    fn colours_are_ordered_and_total() {
-        assert_eq!(heat_color(f32::NAN), heat_color(0.0));
-        let lum = |c: [u8; 3]| c[0] as u32 + c[1] as u32 + c[2] as u32;
-        assert!(lum(heat_color(0.0)) < lum(heat_color(0.75)));
-        assert_eq!(heat_color(2.0), heat_color(1.0));
-    }
-}
-
 /// `img` reduced by 2 in each direction (2x2 box average; odd last row/column dropped).
 pub fn half_size(img: &Plane<[u8; 3]>) -> Plane<[u8; 3]> {
     let (w, h) = (img.width() / 2, img.height() / 2);
@@ -91,4 +79,16 @@ pub fn grid2x2(panels: [&Plane<[u8; 3]>; 4]) -> Plane<[u8; 3]> {
             [0, 0, 0]
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn colours_are_ordered_and_total() {
+        assert_eq!(heat_color(f32::NAN), heat_color(0.0));
+        let lum = |c: [u8; 3]| c[0] as u32 + c[1] as u32 + c[2] as u32;
+        assert!(lum(heat_color(0.0)) < lum(heat_color(0.75)));
+        assert_eq!(heat_color(2.0), heat_color(1.0));
+    }
 }
