@@ -138,15 +138,22 @@ pub struct Attention {
     inhibition: BlobField,
     egosphere: Egosphere,
     inhibition_map: Plane<f32>,
+    /// Scratch: azimuth of each map column and elevation of each map row this frame.
+    col_az: Vec<f32>,
+    row_el: Vec<f32>,
     current: Option<Fixation>,
     frame: usize,
 }
 
-fn argmax(values: impl Iterator<Item = f32>) -> Option<(usize, f32)> {
-    let mut best: Option<(usize, f32)> = None;
-    for (i, v) in values.enumerate() {
-        if v > 0.0 && !matches!(best, Some((_, b)) if v <= b) {
-            best = Some((i, v));
+/// The cell (x, y) maximizing `map * (1 - inhibition)`, and the value, if it is > 0.
+fn argmax_free(map: &Plane<f32>, inhibition: &Plane<f32>) -> Option<((usize, usize), f32)> {
+    let mut best: Option<((usize, usize), f32)> = None;
+    for y in 0..map.height() {
+        for (x, (&m, &i)) in map.row(y).iter().zip(inhibition.row(y)).enumerate() {
+            let v = m * (1.0 - i);
+            if v > 0.0 && !matches!(best, Some((_, b)) if v <= b) {
+                best = Some(((x, y), v));
+            }
         }
     }
     best
@@ -164,6 +171,8 @@ impl Attention {
             habituation: BlobField::default(),
             inhibition: BlobField::default(),
             inhibition_map: Plane::default(),
+            col_az: Vec::new(),
+            row_el: Vec::new(),
             current: None,
             frame: 0,
         })
@@ -230,32 +239,42 @@ impl Attention {
         self.habituation.decay((-1.0 / c.habituation_tau_frames).exp());
         self.inhibition.decay((-1.0 / c.ior_tau_frames).exp());
         self.egosphere.splat(saliency, &self.view, pan_deg, tilt_deg);
-        // Map cell centres in full-frame pixels and on the sphere.
+        // Map cell centres in full-frame pixels and on the sphere (azimuth depends on the
+        // column only, elevation on the row only, in the equiangular model).
         let (mw, mh) = saliency.size();
         let (sx, sy) = (self.view.width as f32 / mw as f32, self.view.height as f32 / mh as f32);
-        let pixel = |i: usize| (((i % mw) as f32 + 0.5) * sx - 0.5, ((i / mw) as f32 + 0.5) * sy - 0.5);
+        let pixel = |x: usize, y: usize| ((x as f32 + 0.5) * sx - 0.5, (y as f32 + 0.5) * sy - 0.5);
+        self.col_az.clear();
+        self.col_az.extend((0..mw).map(|x| self.view.direction(pixel(x, 0).0, 0.0, pan_deg, tilt_deg).0));
+        self.row_el.clear();
+        self.row_el.extend((0..mh).map(|y| self.view.direction(0.0, pixel(0, y).1, pan_deg, tilt_deg).1));
         self.inhibition_map.resize(mw, mh);
-        for i in 0..mw * mh {
-            let (px, py) = pixel(i);
-            let (az, el) = self.view.direction(px, py, pan_deg, tilt_deg);
-            let v = if self.inhibition.blobs.is_empty() { 0.0 } else { self.inhibition.value(az, el).min(1.0) };
-            self.inhibition_map.set(i % mw, i / mw, v);
+        for y in 0..mh {
+            let el = self.row_el[y];
+            let out = self.inhibition_map.row_mut(y);
+            out.fill(0.0);
+            // Blobs further than 4 sigma in elevation cannot reach this row.
+            for b in self.inhibition.blobs.iter().filter(|b| (b.el - el).abs() <= 4.0 * b.sigma_deg) {
+                for (o, &az) in out.iter_mut().zip(&self.col_az) {
+                    *o += b.value(az, el);
+                }
+            }
+            out.iter_mut().for_each(|v| *v = v.min(1.0));
         }
-        let free = |p: &Plane<f32>, i: usize| p.get(i % mw, i / mw) * (1.0 - self.inhibition_map.get(i % mw, i / mw));
         let surprising = surprise
-            .and_then(|s| argmax((0..mw * mh).map(|i| free(s, i))))
+            .and_then(|s| argmax_free(s, &self.inhibition_map))
             .filter(|&(_, v)| v > self.cfg.surprise_threshold_bits);
         let winner = match surprising {
-            Some((i, _)) => Some((i, Reason::Surprising)),
-            None => argmax((0..mw * mh).map(|i| free(saliency, i))).map(|(i, _)| (i, Reason::Salient)),
+            Some((cell, _)) => Some((cell, Reason::Surprising)),
+            None => argmax_free(saliency, &self.inhibition_map).map(|(cell, _)| (cell, Reason::Salient)),
         };
         let frame = self.frame;
         self.frame += 1;
-        let Some((i, reason)) = winner else {
+        let Some(((cx, cy), reason)) = winner else {
             self.current = None;
             return Ok(None);
         };
-        let (x, y) = pixel(i);
+        let (x, y) = pixel(cx, cy);
         let (az, el) = self.view.direction(x, y, pan_deg, tilt_deg);
         let c = &self.cfg;
         let saccade = self

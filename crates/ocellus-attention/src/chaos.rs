@@ -68,6 +68,8 @@ pub struct ChaosDegree {
     /// Counts of the previous motion map, and of the current one.
     hist_prev: Vec<f64>,
     hist: Vec<f64>,
+    /// Scratch: four interleaved integer histograms (see [`histogram_into`]).
+    counts: Vec<u32>,
     frames: usize,
 }
 
@@ -75,7 +77,14 @@ impl ChaosDegree {
     /// A chaos-degree tracker.
     pub fn new(cfg: ChaosConfig) -> Result<Self> {
         cfg.validate()?;
-        Ok(Self { hist_prev: vec![0.0; cfg.bins], hist: vec![0.0; cfg.bins], prev: Plane::default(), frames: 0, cfg })
+        Ok(Self {
+            hist_prev: vec![0.0; cfg.bins],
+            hist: vec![0.0; cfg.bins],
+            counts: vec![0; 4 * cfg.bins],
+            prev: Plane::default(),
+            frames: 0,
+            cfg,
+        })
     }
 
     /// The configuration.
@@ -96,22 +105,32 @@ impl ChaosDegree {
     /// Adds a frame (grey, finite); returns the chaos degree in bits once three frames of the
     /// same size have been seen, else `None`. A size change restarts the count.
     pub fn update(&mut self, grey: &Plane<f32>) -> Result<Option<f64>> {
-        if grey.is_empty() || !grey.all_finite() {
-            return Err(AttentionError::InvalidInput("chaos degree needs a non-empty, finite frame".into()));
+        let bad = || AttentionError::InvalidInput("chaos degree needs a non-empty, finite frame".into());
+        if grey.is_empty() {
+            return Err(bad());
         }
         if grey.size() != self.prev.size() {
             self.frames = 0;
         }
-        let mut s = None;
-        if self.frames >= 1 {
-            std::mem::swap(&mut self.hist, &mut self.hist_prev);
-            motion_histogram(grey, &self.prev, self.cfg.max_difference, &mut self.hist);
-            if self.frames >= 2 {
-                s = Some(relative_entropy_bits(&self.hist, &self.hist_prev, self.cfg.empty_bin_probability));
+        if self.frames == 0 {
+            if !grey.all_finite() {
+                return Err(bad());
             }
+            self.prev.resize(grey.width(), grey.height());
+            self.prev.copy_from(grey);
+            self.frames = 1;
+            return Ok(None);
         }
-        self.prev.resize(grey.width(), grey.height());
-        self.prev.copy_from(grey);
+        std::mem::swap(&mut self.hist, &mut self.hist_prev);
+        // One pass: histogram of |I_t - I_(t-1)|, finiteness check, and I_t kept for next time.
+        let finite =
+            histogram_and_store(grey, &mut self.prev, self.cfg.max_difference, &mut self.counts, &mut self.hist);
+        if !finite {
+            self.frames = 0;
+            return Err(bad());
+        }
+        let s = (self.frames >= 2)
+            .then(|| relative_entropy_bits(&self.hist, &self.hist_prev, self.cfg.empty_bin_probability));
         self.frames += 1;
         Ok(s)
     }
@@ -120,19 +139,57 @@ impl ChaosDegree {
 /// Histogram (counts) of `|a - b|` over `out.len()` bins spanning `[0, max_difference]`;
 /// differences beyond go to the last bin. `a` and `b` have the same size.
 pub fn motion_histogram(a: &Plane<f32>, b: &Plane<f32>, max_difference: f32, out: &mut [f64]) {
-    out.iter_mut().for_each(|c| *c = 0.0);
+    let mut counts = vec![0; 4 * out.len()];
+    let mut b = b.clone();
+    histogram_and_store(a, &mut b, max_difference, &mut counts, out);
+}
+
+/// [`motion_histogram`] of `a` against `b` that then copies `a` into `b`, with a scratch of
+/// `4 * bins` counters: four histograms filled by interleaved pixels, so that runs of equal
+/// bins (a still scene puts almost every pixel in bin 0) do not serialize on one counter.
+/// Returns `false` if `a` has a non-finite value.
+fn histogram_and_store(
+    a: &Plane<f32>,
+    b: &mut Plane<f32>,
+    max_difference: f32,
+    counts: &mut [u32],
+    out: &mut [f64],
+) -> bool {
     let n = out.len();
     if n == 0 {
-        return;
+        return true;
     }
+    counts.iter_mut().for_each(|c| *c = 0);
     let scale = n as f32 / max_difference;
     let last = n - 1;
+    let bin = |p: f32, q: f32| (((p - q).abs() * scale) as usize).min(last);
+    let (c0, rest) = counts.split_at_mut(n);
+    let (c1, rest) = rest.split_at_mut(n);
+    let (c2, c3) = rest.split_at_mut(n);
+    // p * 0 is 0 for finite p and NaN otherwise; the sum flags any non-finite pixel.
+    let mut finite_probe = 0.0f32;
     for y in 0..a.height() {
-        for (p, q) in a.row(y).iter().zip(b.row(y)) {
-            // Counts stay exact in f64 up to 2^53 pixels.
-            out[(((p - q).abs() * scale) as usize).min(last)] += 1.0;
+        let (ra, rb) = (a.row(y), b.row_mut(y));
+        let mut pa = ra.chunks_exact(4);
+        let mut pb = rb.chunks_exact_mut(4);
+        for (p, q) in pa.by_ref().zip(pb.by_ref()) {
+            c0[bin(p[0], q[0])] += 1;
+            c1[bin(p[1], q[1])] += 1;
+            c2[bin(p[2], q[2])] += 1;
+            c3[bin(p[3], q[3])] += 1;
+            finite_probe += p[0] * 0.0 + p[1] * 0.0 + p[2] * 0.0 + p[3] * 0.0;
+            q.copy_from_slice(p);
+        }
+        for (p, q) in pa.remainder().iter().zip(pb.into_remainder()) {
+            c0[bin(*p, *q)] += 1;
+            finite_probe += p * 0.0;
+            *q = *p;
         }
     }
+    for (k, o) in out.iter_mut().enumerate() {
+        *o = (c0[k] as u64 + c1[k] as u64 + c2[k] as u64 + c3[k] as u64) as f64;
+    }
+    finite_probe == 0.0
 }
 
 /// `KL(p || q)` in bits between two histograms of counts, each normalized and smoothed as
@@ -174,6 +231,22 @@ mod tests {
     }
 
     #[test]
+    fn interleaved_histogram_equals_a_plain_count() {
+        let a = Plane::from_fn(13, 7, |x, y| ((x * 31 + y * 17) % 97) as f32 / 97.0);
+        let b = Plane::from_fn(13, 7, |x, y| ((x * 7 + y * 3) % 89) as f32 / 89.0);
+        let mut h = vec![0.0; 10];
+        motion_histogram(&a, &b, 0.8, &mut h);
+        let mut want = vec![0.0; 10];
+        for y in 0..7 {
+            for x in 0..13 {
+                let d = (a.get(x, y) - b.get(x, y)).abs();
+                want[((d * 10.0 / 0.8) as usize).min(9)] += 1.0;
+            }
+        }
+        assert_eq!(h, want);
+    }
+
+    #[test]
     fn histogram_bins_and_saturation() {
         let a = Plane::from_vec(4, 1, vec![0.0, 0.3, 0.6, 1.0]).unwrap();
         let b = Plane::new(4, 1);
@@ -200,5 +273,11 @@ mod tests {
         assert!(!c.is_familiar(s), "s = {s}");
         assert!(c.update(&Plane::new(8, 8)).unwrap().is_none(), "size change restarts");
         assert!(c.update(&Plane::from_fn(8, 8, |_, _| f32::NAN)).is_err());
+        // A non-finite pixel in a later frame (the fused histogram pass) is caught too.
+        let mut d = ChaosDegree::new(ChaosConfig::default()).unwrap();
+        d.update(&still).unwrap();
+        let mut bad = still.clone();
+        bad.set(31, 31, f32::INFINITY);
+        assert!(d.update(&bad).is_err());
     }
 }

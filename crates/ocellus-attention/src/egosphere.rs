@@ -17,7 +17,11 @@ use ocellus_image::Plane;
 use serde::{Deserialize, Serialize};
 
 /// Wraps an angle difference to (-180, 180] degrees.
+#[inline]
 pub fn wrap_deg(a: f32) -> f32 {
+    if a > -180.0 && a <= 180.0 {
+        return a; // the common case, without a float remainder
+    }
     let r = (a + 180.0).rem_euclid(360.0) - 180.0;
     if r == -180.0 {
         180.0
@@ -211,14 +215,24 @@ impl Egosphere {
         let (y0, y1) = (self.cell(0.0, tilt_deg - half_h).1, self.cell(0.0, tilt_deg + half_h).1);
         let n_cols = ((2.0 * half_w / self.deg_per_cell).ceil() as usize + 1).min(w);
         let x_start = self.cell(pan_deg - half_w, 0.0).0;
+        let (cx, cy) = ((view.width as f32 - 1.0) / 2.0, (view.height as f32 - 1.0) / 2.0);
         for y in y0..=y1 {
+            let el = self.cell_direction(0, y).1;
+            let py = (el - tilt_deg) / view.deg_per_px + cy;
+            if py <= -0.5 || py >= view.height as f32 - 0.5 {
+                continue;
+            }
+            let map_row = map.row((((py + 0.5) * sy) as usize).min(map.height() - 1));
+            let out = self.mosaic.row_mut(y);
+            // Image column of the first cell; each further cell is deg_per_cell further right.
+            let az0 = -180.0 + (x_start as f32 + 0.5) * self.deg_per_cell;
+            let px0 = wrap_deg(az0 - pan_deg) / view.deg_per_px + cx;
+            let step = self.deg_per_cell / view.deg_per_px;
+            let (lo, hi) = (-0.5, view.width as f32 - 0.5);
             for i in 0..n_cols {
-                let x = (x_start + i) % w;
-                let (az, el) = self.cell_direction(x, y);
-                if let Some((px, py)) = view.pixel(az, el, pan_deg, tilt_deg) {
-                    let mx = (((px + 0.5) * sx) as usize).min(map.width() - 1);
-                    let my = (((py + 0.5) * sy) as usize).min(map.height() - 1);
-                    self.mosaic.set(x, y, map.get(mx, my));
+                let px = px0 + i as f32 * step;
+                if px > lo && px < hi {
+                    out[(x_start + i) % w] = map_row[(((px + 0.5) * sx) as usize).min(map_row.len() - 1)];
                 }
             }
         }

@@ -89,6 +89,9 @@ pub struct Surprise {
     height: usize,
     /// `alpha` per model, per cell (row-major).
     alpha: Vec<Vec<f64>>,
+    /// `(ln Gamma(alpha), psi(alpha))` per model, per cell: this frame's prior is the last
+    /// frame's posterior, so each frame needs the special functions once per changed cell.
+    special: Vec<Vec<(f64, f64)>>,
     /// `beta` per model (the update does not depend on the data, so it is one number).
     beta: Vec<f64>,
     /// Scratch: the data each model sees.
@@ -107,6 +110,7 @@ impl Surprise {
         let n = width * height;
         Ok(Self {
             alpha: vec![vec![0.0; n]; cfg.models],
+            special: vec![vec![(0.0, 0.0); n]; cfg.models],
             beta: vec![0.0; cfg.models],
             data: vec![0.0; n],
             map: Plane::new(width, height),
@@ -155,28 +159,45 @@ impl Surprise {
         }
         let (xi, floor) = (self.cfg.update_factor, self.cfg.alpha_floor);
         self.map.fill(0.0);
+        let w = self.width;
         for m in 0..self.cfg.models {
-            let alpha = &mut self.alpha[m];
+            let (alpha, special) = (&mut self.alpha[m], &mut self.special[m]);
             if !self.started {
-                for (a, &d) in alpha.iter_mut().zip(&self.data) {
+                for ((a, sp), &d) in alpha.iter_mut().zip(special.iter_mut()).zip(&self.data) {
                     *a = (d / (1.0 - xi)).max(floor);
+                    *sp = ln_gamma_digamma(*a);
                 }
                 self.beta[m] = 1.0 / (1.0 - xi);
             } else {
                 let b0 = self.beta[m];
-                let b1 = xi * b0 + 1.0;
-                for (i, (a, d)) in alpha.iter_mut().zip(self.data.iter_mut()).enumerate() {
-                    let a1 = (xi * *a + *d).max(floor);
-                    let kl = match self.cfg.direction {
-                        KlDirection::PosteriorPrior => kl_gamma(a1, b1, *a, b0),
-                        KlDirection::PriorPosterior => kl_gamma(*a, b0, a1, b1),
-                    };
-                    let (x, y) = (i % self.width, i / self.width);
-                    let cell = &mut self.map.row_mut(y)[x];
-                    *cell += (kl / std::f64::consts::LN_2) as f32;
-                    *a = a1;
-                    // The next model of the chain sees this model's posterior mean.
-                    *d = a1 / b1;
+                let mut b1 = xi * b0 + 1.0;
+                // At the steady state b1 = b0 up to rounding: keep it exact, so that an
+                // unchanged alpha gives exactly zero surprise without any special function.
+                if (b1 - b0).abs() <= 1e-12 * b0 {
+                    b1 = b0;
+                }
+                let (ln_b, db) = ((b1 / b0).ln(), b0 - b1);
+                for (y, row) in self.data.chunks_exact_mut(w).enumerate() {
+                    let out = self.map.row_mut(y);
+                    let i0 = y * w;
+                    for (x, d) in row.iter_mut().enumerate() {
+                        let (a, sp) = (&mut alpha[i0 + x], &mut special[i0 + x]);
+                        let a1 = (xi * *a + *d).max(floor);
+                        // The next model of the chain sees this model's posterior mean.
+                        *d = a1 / b1;
+                        if a1 == *a && db == 0.0 {
+                            continue;
+                        }
+                        let (lg0, psi0) = *sp;
+                        let (lg1, psi1) = ln_gamma_digamma(a1);
+                        // Closed forms of kl_gamma with the cached prior terms.
+                        let kl = match self.cfg.direction {
+                            KlDirection::PosteriorPrior => (a1 - *a) * psi1 - lg1 + lg0 + *a * ln_b + a1 * db / b1,
+                            KlDirection::PriorPosterior => (*a - a1) * psi0 - lg0 + lg1 - a1 * ln_b - *a * db / b0,
+                        };
+                        out[x] += (kl.max(0.0) / std::f64::consts::LN_2) as f32;
+                        (*a, *sp) = (a1, (lg1, psi1));
+                    }
                 }
                 self.beta[m] = b1;
             }
@@ -197,6 +218,34 @@ pub fn kl_gamma(a1: f64, b1: f64, a2: f64, b2: f64) -> f64 {
     let kl = (a1 - a2) * digamma(a1) - ln_gamma(a1) + ln_gamma(a2) + a2 * (b1 / b2).ln() + a1 * (b2 - b1) / b1;
     // Rounding can make a zero divergence slightly negative.
     kl.max(0.0)
+}
+
+/// `(ln Gamma(x), psi(x))` for `x > 0` in one pass: the shift to x >= 8 keeps the product
+/// `P = x (x + 1) ...` and its derivative `P'`, so `sum 1 / (x + i) = P' / P` costs one division.
+pub fn ln_gamma_digamma(x: f64) -> (f64, f64) {
+    let (mut z, mut p, mut dp) = (x, 1.0, 0.0);
+    while z < 8.0 {
+        dp = dp * z + p;
+        p *= z;
+        z += 1.0;
+    }
+    let inv = 1.0 / z;
+    let inv2 = inv * inv;
+    let ln_z = z.ln();
+    let lg_series = inv
+        * (1.0 / 12.0
+            - inv2
+                * (1.0 / 360.0
+                    - inv2
+                        * (1.0 / 1260.0 - inv2 * (1.0 / 1680.0 - inv2 * (1.0 / 1188.0 - inv2 * 691.0 / 360_360.0)))));
+    let psi_series = inv2
+        * (1.0 / 12.0
+            - inv2
+                * (1.0 / 120.0
+                    - inv2 * (1.0 / 252.0 - inv2 * (1.0 / 240.0 - inv2 * (1.0 / 132.0 - inv2 * 691.0 / 32_760.0)))));
+    let lg = (z - 0.5) * ln_z - z + 0.5 * (2.0 * std::f64::consts::PI).ln() + lg_series - p.ln();
+    let psi = ln_z - 0.5 * inv - psi_series - dp / p;
+    (lg, psi)
 }
 
 /// `ln Gamma(x)` for `x > 0`: recurrence up to x >= 8, then Stirling's series (error < 1e-14).
@@ -238,6 +287,37 @@ pub fn digamma(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn joint_special_functions_match_the_separate_ones() {
+        for &x in &[0.01, 0.3, 1.0, 2.5, 7.9, 8.0, 13.0, 250.0] {
+            let (lg, psi) = ln_gamma_digamma(x);
+            assert!((lg - ln_gamma(x)).abs() < 1e-12 * (1.0 + lg.abs()), "lnG({x})");
+            assert!((psi - digamma(x)).abs() < 1e-12 * (1.0 + psi.abs()), "psi({x})");
+        }
+    }
+
+    #[test]
+    fn cached_update_equals_the_direct_formula() {
+        // Surprise of one cell over a few frames, against kl_gamma on the same beliefs.
+        for dir in [KlDirection::PosteriorPrior, KlDirection::PriorPosterior] {
+            let cfg = SurpriseConfig { direction: dir, ..Default::default() };
+            let mut s = Surprise::new(cfg, 1, 1).unwrap();
+            let (xi, b) = (0.7, 1.0 / 0.3);
+            let mut a = 2.0 / 0.3;
+            s.update(&Plane::from_fn(1, 1, |_, _| 2.0)).unwrap();
+            for &v in &[2.0f32, 5.0, 0.0, 0.0, 3.5] {
+                let a1 = (xi * a + v as f64).max(1e-2);
+                let want = match dir {
+                    KlDirection::PosteriorPrior => kl_gamma(a1, b, a, b),
+                    KlDirection::PriorPosterior => kl_gamma(a, b, a1, b),
+                } / std::f64::consts::LN_2;
+                let got = s.update(&Plane::from_fn(1, 1, |_, _| v)).unwrap().get(0, 0) as f64;
+                assert!((got - want).abs() < 1e-5 * (1.0 + want), "{dir:?} {v}: {got} vs {want}");
+                a = a1;
+            }
+        }
+    }
 
     #[test]
     fn special_functions_match_known_values() {

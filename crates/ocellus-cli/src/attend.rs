@@ -208,6 +208,14 @@ pub fn stream_config(preset: &str, config: Option<&Path>, chain: bool, deg_per_p
 
 /// Runs the subcommand.
 pub fn run(a: AttendArgs) -> Result<()> {
+    let out = a.out.clone();
+    let (n, saccades, written) = run_quiet(a)?;
+    println!("{n} frames, {saccades} saccades; wrote {} in {}", written.join(", "), out.display());
+    Ok(())
+}
+
+/// Runs the subcommand without the summary line: (frames, saccades, files written).
+pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
     let cfg = stream_config(&a.preset, a.config.as_deref(), a.surprise_chain, a.deg_per_px)?;
     let pan_tilt = a.pan_tilt.as_deref().map(frames::read_pan_tilt).transpose()?;
     let mut out = Outputs::new(&a.out, !a.no_overlays)?;
@@ -230,6 +238,5 @@ pub fn run(a: AttendArgs) -> Result<()> {
     let saccades = out.saccades;
     let written = out.finish(threshold)?;
     let n = result?;
-    println!("{n} frames, {saccades} saccades; wrote {} in {}", written.join(", "), a.out.display());
-    Ok(())
+    Ok((n, saccades, written))
 }

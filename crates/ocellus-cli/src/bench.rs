@@ -14,6 +14,9 @@ use std::time::{Duration, Instant};
 pub enum Target {
     /// The saliency pipeline (SPEC 1): per-preset ms/frame on one core, fps on all cores.
     Saliency,
+    /// Surprise, chaos and attention per frame on top of saliency (640x480, one core), and
+    /// end-to-end fps of `ocellus attend` from video files, decode included.
+    Attention,
 }
 
 /// Arguments of `ocellus bench`.
@@ -24,7 +27,7 @@ pub struct BenchArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
-    /// Frames timed per preset on one thread (the median is reported).
+    /// Frames timed on one thread (the median is reported).
     #[arg(long, default_value_t = 300)]
     pub frames: usize,
     /// Frame width in pixels (the built-in images are resized to it).
@@ -61,7 +64,8 @@ fn frames(a: &BenchArgs) -> Result<Vec<RgbImage>> {
         .collect()
 }
 
-fn median(v: &mut [f64]) -> f64 {
+/// Median (sorts `v`); 0 for an empty slice.
+pub fn median(v: &mut [f64]) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
     if v.is_empty() {
         0.0
@@ -161,9 +165,11 @@ fn throughput(cfg: &SaliencyConfig, frames: &[RgbImage], threads: usize, n: usiz
 
 /// Runs the subcommand.
 pub fn run(a: BenchArgs) -> Result<()> {
-    let Target::Saliency = a.target;
     if a.frames == 0 {
         bail!("--frames must be at least 1");
+    }
+    if let Target::Attention = a.target {
+        return crate::bench_attention::run(a.json, a.frames);
     }
     let backend: Backend = serde_json::from_value(json!(a.backend))
         .with_context(|| format!("unknown backend '{}' (auto, scalar, avx2)", a.backend))?;

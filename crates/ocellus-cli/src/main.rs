@@ -3,6 +3,7 @@
 mod assets;
 mod attend;
 mod bench;
+mod bench_attention;
 mod config_file;
 mod demo;
 mod eval;
