@@ -1,9 +1,11 @@
 //! `ocellus demo`: the main capabilities end to end on the built-in images.
 
-use crate::{assets, inputs, saliency_cmd};
+use crate::attend::{self, AttendArgs};
+use crate::{assets, generate, inputs, saliency_cmd};
 use anyhow::{Context, Result};
 use clap::Args;
 use ocellus_attention::SaliencyConfig;
+use ocellus_synth::attention_scenes::{Scenario, SceneConfig};
 use std::path::PathBuf;
 
 /// Arguments of `ocellus demo`.
@@ -14,7 +16,8 @@ pub struct DemoArgs {
     pub out: PathBuf,
 }
 
-/// Runs the demo: saliency maps, conspicuity maps and overlays with both presets.
+/// Runs the demo: saliency maps, conspicuity maps and overlays with both presets, then
+/// attention over a generated sequence.
 pub fn run(a: DemoArgs) -> Result<()> {
     let dir = a.out;
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -44,5 +47,30 @@ pub fn run(a: DemoArgs) -> Result<()> {
         }
     }
     println!("wrote maps, conspicuity maps and overlays to {}", dir.display());
+
+    // Attention over time: a generated sequence in which an object appears at frame 15.
+    println!("ocellus demo: surprise, context chaos and attention on a generated 30-frame sequence");
+    let seq = dir.join("sequence");
+    let cfg = SceneConfig::new(Scenario::SuddenObject);
+    let event = cfg.event_frame;
+    generate::write_sequence(cfg, &seq, false)?;
+    let args = AttendArgs {
+        input: seq.join("frames"),
+        pan_tilt: Some(seq.join("pan_tilt.csv")),
+        deg_per_px: 0.1,
+        out: dir.join("attend"),
+        preset: "ace2009".into(),
+        config: None,
+        surprise_chain: false,
+        no_overlays: false,
+        fps: 30,
+        limit: None,
+    };
+    let (n, saccades, written) = attend::run_quiet(args)?;
+    println!(
+        "  {n} frames, object appears at frame {event}; {saccades} saccades; wrote {} to {}",
+        written.join(", "),
+        dir.join("attend").display()
+    );
     Ok(())
 }

@@ -68,6 +68,11 @@ pub fn scene(cfg: SceneConfig) -> Result<SceneGenerator> {
     Ok(SceneGenerator::new(cfg, &world, &img("chelsea.png")?)?)
 }
 
+struct Out {
+    out: PathBuf,
+    y4m: bool,
+}
+
 /// Runs the subcommand.
 pub fn run(a: GenerateArgs) -> Result<()> {
     let What::Attention(a) = a.what;
@@ -84,7 +89,14 @@ pub fn run(a: GenerateArgs) -> Result<()> {
         pan_px_per_frame: a.pan_px_per_frame,
         ..SceneConfig::new(scenario)
     };
+    write_sequence(cfg, &a.out, a.y4m)
+}
+
+/// Writes a sequence to `out`: frames/ (or sequence.y4m), truth.csv, pan_tilt.csv.
+pub fn write_sequence(cfg: SceneConfig, out: &Path, y4m: bool) -> Result<()> {
+    let scenario = cfg.scenario;
     let g = scene(cfg)?;
+    let a = Out { out: out.to_path_buf(), y4m };
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
     let create = |name: &str| -> Result<std::io::BufWriter<std::fs::File>> {
         let p = a.out.join(name);

@@ -221,3 +221,104 @@ fn eval_location_metrics_from_csv_points_and_binary_maps_agree() {
     let c = run("centre".into(), &csv_dir);
     assert!(c["NSS"] < a["NSS"] && c["IG"].abs() < 1e-9, "centre model is the IG baseline: {c:?}");
 }
+
+fn generate(dir: &std::path::Path, scenario: &str, frames: usize, event: usize, y4m: bool) {
+    let mut c = ocellus();
+    c.args(["generate", "attention", "--scenario", scenario, "--frames"])
+        .arg(frames.to_string())
+        .arg("--event-frame")
+        .arg(event.to_string())
+        .arg("--out")
+        .arg(dir);
+    if y4m {
+        c.arg("--y4m");
+    }
+    let o = c.output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+fn csv_rows(path: &std::path::Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(path).unwrap().lines().skip(1).map(|l| l.split(',').map(str::to_string).collect()).collect()
+}
+
+#[test]
+fn attend_finds_the_sudden_object_and_writes_every_output() {
+    let dir = tmpdir("attend");
+    let seq = dir.join("seq");
+    generate(&seq, "sudden", 20, 10, false);
+    // The object's rectangle at the event frame, from the generator's truth.
+    let truth = csv_rows(&seq.join("truth.csv"));
+    let r: Vec<f32> = truth[10][3..7].iter().map(|v| v.parse().unwrap()).collect();
+    let out = dir.join("out");
+    let o = ocellus()
+        .arg("attend")
+        .arg(seq.join("frames"))
+        .arg("--pan-tilt")
+        .arg(seq.join("pan_tilt.csv"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let context = csv_rows(&out.join("context.csv"));
+    assert_eq!(context.len(), 20);
+    let chaos = |k: usize| context[k][1].parse::<f64>().unwrap_or(0.0);
+    assert!(chaos(10) > 1.0 && (2..10).all(|k| chaos(k) < 1.0), "chaos {:?}", context);
+    assert_eq!(context[10][2], "0", "unfamiliar at the event");
+    let scanpath = csv_rows(&out.join("scanpath.csv"));
+    let hit = scanpath.iter().find(|s| s[0] == "10").expect("a saccade at the event frame");
+    let (x, y): (f32, f32) = (hit[1].parse().unwrap(), hit[2].parse().unwrap());
+    assert_eq!(hit[5], "surprising");
+    assert!(x >= r[0] && x < r[0] + r[2] && y >= r[1] && y < r[1] + r[3], "saccade to ({x}, {y}), object {r:?}");
+    assert_eq!(std::fs::read_dir(out.join("overlays")).unwrap().count(), 20);
+    for f in ["overlays.mp4", "context.png"] {
+        assert!(out.join(f).metadata().unwrap().len() > 1000, "{f}");
+    }
+    // The surprise command on the same frames as an MPEG-4 video made by ffmpeg.
+    let mp4 = dir.join("seq.mp4");
+    let st = Command::new("ffmpeg")
+        .args(["-v", "error", "-y", "-framerate", "30", "-i"])
+        .arg(seq.join("frames").join("frame_%05d.png"))
+        .args(["-c:v", "mpeg4", "-q:v", "2"])
+        .arg(&mp4)
+        .status()
+        .expect("ffmpeg (scripts/setup.sh installs it)");
+    assert!(st.success());
+    let sout = dir.join("surprise");
+    let o = ocellus().arg("surprise").arg(&mp4).arg("--out").arg(&sout).arg("--npy").output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows = csv_rows(&sout.join("surprise.csv"));
+    assert_eq!(rows.len(), 20);
+    let peak =
+        rows.iter().max_by(|a, b| a[1].parse::<f64>().unwrap().total_cmp(&b[1].parse::<f64>().unwrap())).unwrap();
+    assert_eq!(peak[0], "10", "surprise peaks when the object appears");
+    assert!(sout.join("surprise").join("frame_00010.npy").is_file());
+}
+
+#[test]
+fn attend_on_a_cut_video_keeps_the_frames_before_and_names_the_frame() {
+    let dir = tmpdir("attend-cut");
+    let seq = dir.join("seq");
+    generate(&seq, "static", 10, 5, true);
+    let y4m = seq.join("sequence.y4m");
+    let bytes = std::fs::read(&y4m).unwrap();
+    let frame_len = 6 + 3 * 640 * 480;
+    let header = bytes.len() - 10 * frame_len;
+    let cut = dir.join("cut.y4m");
+    std::fs::write(&cut, &bytes[..header + 7 * frame_len + 12345]).unwrap();
+    let out = dir.join("out");
+    let o = ocellus().arg("attend").arg(&cut).arg("--out").arg(&out).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(err.contains("frame 7") && err.contains("truncated"), "{err}");
+    assert_eq!(csv_rows(&out.join("context.csv")).len(), 7, "the 7 frames before the cut are written");
+    assert_eq!(std::fs::read_dir(out.join("overlays")).unwrap().count(), 7);
+    assert!(out.join("context.png").is_file());
+    // A pan-tilt CSV that misses frames is an error that says which.
+    let pt = dir.join("pt.csv");
+    std::fs::write(&pt, "frame,pan_deg,tilt_deg\n0,0,0\n1,0.5,0\n").unwrap();
+    let o =
+        ocellus().arg("attend").arg(&y4m).arg("--pan-tilt").arg(&pt).arg("--out").arg(dir.join("o2")).output().unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("no row for frame 2"));
+}
