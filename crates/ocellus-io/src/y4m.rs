@@ -12,7 +12,7 @@
 use crate::{IoError, Result};
 use ocellus_image::convert::RgbImage;
 use ocellus_image::Plane;
-use std::io::{BufRead, Write};
+use std::io::{BufRead, Read, Write};
 use std::path::{Path, PathBuf};
 
 /// Chroma subsampling of a stream.
@@ -118,7 +118,7 @@ fn parse_header(line: &[u8], path: &Path) -> Result<Y4mHeader> {
             _ => {} // interlacing, aspect ratio, comments: not needed for RGB frames
         }
     }
-    if h.width == 0 || h.height == 0 || h.width > 1 << 15 || h.height > 1 << 15 {
+    if h.width == 0 || h.height == 0 || h.width > 1 << 15 || h.height > 1 << 15 || h.width * h.height > 1 << 26 {
         return Err(IoError::Invalid { path: path.into(), reason: format!("frame size {}x{}", h.width, h.height) });
     }
     Ok(h)
@@ -167,7 +167,7 @@ impl<R: BufRead> Y4mReader<R> {
     pub fn new(mut input: R, path: &Path) -> Result<Self> {
         let line = read_line(&mut input, path, "header")?.ok_or_else(|| IoError::EmptyFile { path: path.into() })?;
         let header = parse_header(&line, path)?;
-        Ok(Self { input, path: path.into(), buf: vec![0; header.frame_bytes()], header, frame: 0 })
+        Ok(Self { input, path: path.into(), buf: Vec::new(), header, frame: 0 })
     }
 
     /// The stream header.
@@ -194,16 +194,16 @@ impl<R: BufRead> Y4mReader<R> {
         if !line.starts_with(b"FRAME") {
             return Err(self.video_error("expected a FRAME marker".into()));
         }
-        let mut got = 0;
-        while got < self.buf.len() {
-            match self.input.read(&mut self.buf[got..]) {
-                Ok(0) => {
-                    return Err(self.video_error(format!("truncated: {got} of {} bytes", self.buf.len())));
-                }
-                Ok(n) => got += n,
-                Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
-                Err(e) => return Err(self.video_error(e.to_string())),
-            }
+        // Read up to the frame's size: the buffer grows with the data actually present, so a
+        // header that promises huge frames cannot make us allocate them.
+        let n = self.header.frame_bytes();
+        self.buf.clear();
+        let read = (&mut self.input).take(n as u64).read_to_end(&mut self.buf);
+        if let Err(e) = read {
+            return Err(self.video_error(e.to_string()));
+        }
+        if self.buf.len() < n {
+            return Err(self.video_error(format!("truncated: {} of {n} bytes", self.buf.len())));
         }
         let img = self.to_rgb();
         self.frame += 1;
