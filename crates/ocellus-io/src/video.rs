@@ -69,6 +69,7 @@ struct Ffmpeg {
     stderr: StderrTail,
     width: usize,
     height: usize,
+    buf: Vec<u8>,
 }
 
 impl Drop for Ffmpeg {
@@ -157,7 +158,8 @@ impl Ffmpeg {
                 }
             }
         });
-        Ok(Self { child, stdout: BufReader::with_capacity(1 << 20, stdout), stderr, width, height })
+        let buf = vec![0u8; width * height * 3];
+        Ok(Self { child, stdout: BufReader::with_capacity(1 << 20, stdout), stderr, width, height, buf })
     }
 
     fn stderr_text(&self) -> String {
@@ -167,11 +169,10 @@ impl Ffmpeg {
     /// The next frame; at the end, ffmpeg's exit status and messages decide between the end of
     /// the video and an error.
     fn next(&mut self, path: &Path, frame: usize) -> Result<Option<RgbImage>> {
-        let n = self.width * self.height * 3;
-        let mut buf = vec![0u8; n];
+        let n = self.buf.len();
         let mut got = 0;
         while got < n {
-            match self.stdout.read(&mut buf[got..]) {
+            match self.stdout.read(&mut self.buf[got..]) {
                 Ok(0) => break,
                 Ok(k) => got += k,
                 Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
@@ -179,8 +180,9 @@ impl Ffmpeg {
             }
         }
         if got == n {
-            let px = ocellus_image::Plane::from_fn(self.width, self.height, |x, y| {
-                let i = 3 * (y * self.width + x);
+            let (w, buf) = (self.width, &self.buf);
+            let px = ocellus_image::Plane::from_fn(w, self.height, |x, y| {
+                let i = 3 * (y * w + x);
                 [buf[i], buf[i + 1], buf[i + 2]]
             });
             return Ok(Some(RgbImage::U8(px)));
