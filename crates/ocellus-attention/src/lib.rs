@@ -30,6 +30,7 @@ pub mod config;
 pub mod egosphere;
 pub mod gabor;
 pub mod normalize;
+pub mod planning;
 pub mod saliency;
 pub mod stream;
 pub mod surprise;
