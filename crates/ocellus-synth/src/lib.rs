@@ -2,6 +2,8 @@
 //!
 //! - [`attention_scenes`]: sequences for surprise, context and attention (a static scene with
 //!   sensor noise, an object that appears suddenly, a steady camera pan), with per-frame truth.
+//! - [`corridor`]: a corridor with textured walls, poster landmarks and a person, rendered by
+//!   a pinhole camera with a pan angle (view-planning experiments).
 //!
 //! Conventions: x right, y down, pixel centres at integer coordinates; grey levels of noise in
 //! 8-bit units; every random choice comes from a seed, so the same configuration gives the
@@ -21,6 +23,7 @@
 //! ```
 
 pub mod attention_scenes;
+pub mod corridor;
 
 use thiserror::Error;
 
