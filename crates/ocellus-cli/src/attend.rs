@@ -156,15 +156,20 @@ impl Outputs {
         if self.overlays {
             written.push("overlays/".into());
         }
-        plot::line_plot(
+        let series = [
+            plot::Series { label: "chaos degree s", points: self.chaos, color: RGBColor(200, 40, 40) },
+            plot::Series { label: "max surprise", points: self.surprise_max, color: RGBColor(30, 90, 200) },
+        ];
+        plot::draw(
             &self.dir.join("context.png"),
-            "context chaos degree and surprise per frame",
-            "bits",
-            &[
-                plot::Series { label: "chaos degree s", points: self.chaos, color: RGBColor(200, 40, 40) },
-                plot::Series { label: "max surprise", points: self.surprise_max, color: RGBColor(30, 90, 200) },
-            ],
-            Some((threshold, "threshold S")),
+            &plot::Plot {
+                title: "context chaos degree and surprise per frame",
+                x_label: "frame",
+                y_label: "bits",
+                series: &series,
+                threshold: Some((threshold, "threshold S")),
+                y_range: None,
+            },
         )?;
         written.push("context.png".into());
         Ok(written)

@@ -5,12 +5,14 @@ mod attend;
 mod bench;
 mod bench_attention;
 mod config_file;
+mod corridor_sim;
 mod demo;
 mod eval;
 mod frames;
 mod generate;
 mod inputs;
 mod overlay;
+mod plan_cmd;
 mod plot;
 mod saliency_cmd;
 mod surprise_cmd;
@@ -46,6 +48,9 @@ enum Command {
     Attend(attend::AttendArgs),
     /// Bayesian surprise maps (bits) of a video or image sequence, and the per-frame maximum.
     Surprise(surprise_cmd::SurpriseArgs),
+    /// Information-based view-direction planning in a simulated corridor (top-down landmarks
+    /// vs bottom-up surprise, switched by the context chaos degree).
+    Plan(plan_cmd::PlanArgs),
     /// Generate ground-truth sequences from the built-in real images.
     Generate(generate::GenerateArgs),
     /// Print benchmark figures (median ms per frame, fps on all cores, per stage, peak memory).
@@ -62,6 +67,7 @@ fn main() {
         Command::Attend(a) => attend::run(a),
         Command::Surprise(a) => surprise_cmd::run(a),
         Command::Generate(a) => generate::run(a),
+        Command::Plan(a) => plan_cmd::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

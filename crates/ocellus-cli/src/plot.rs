@@ -1,4 +1,4 @@
-//! Line plots of per-frame values (PNG), with the embedded DejaVu Sans Mono font.
+//! Line plots (PNG), with the embedded DejaVu Sans Mono font.
 
 use anyhow::{anyhow, Result};
 use plotters::prelude::*;
@@ -15,80 +15,81 @@ fn register_font() {
     });
 }
 
-/// One line: a label and its (frame, value) points.
+/// One line: a label and its (x, y) points.
 pub struct Series<'a> {
     pub label: &'a str,
     pub points: Vec<(f64, f64)>,
     pub color: RGBColor,
 }
 
-/// Writes a plot of `series` against the frame index with a dashed horizontal line at
-/// `threshold` (if any), `title` on top, `y_label` on the vertical axis.
-pub fn line_plot(
-    path: &Path,
-    title: &str,
-    y_label: &str,
-    series: &[Series],
-    threshold: Option<(f64, &str)>,
-) -> Result<()> {
+/// A plot of lines.
+pub struct Plot<'a> {
+    pub title: &'a str,
+    pub x_label: &'a str,
+    pub y_label: &'a str,
+    pub series: &'a [Series<'a>],
+    /// A dashed horizontal line (value, label).
+    pub threshold: Option<(f64, &'a str)>,
+    /// The vertical range; default from 0 (or the data's minimum) to 1.1 x the maximum.
+    pub y_range: Option<(f64, f64)>,
+}
+
+/// Writes `plot` as a 960x480 PNG.
+pub fn draw(path: &Path, plot: &Plot) -> Result<()> {
     register_font();
     let (w, h) = (960u32, 480u32);
     let mut buf = vec![0u8; (w * h * 3) as usize];
-    draw(&mut buf, (w, h), path, title, y_label, series, threshold)?;
+    render(&mut buf, (w, h), plot).map_err(|e| anyhow!("plot {}: {e}", path.display()))?;
     let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
     ocellus_io::write_png(path, &img)?;
     Ok(())
 }
 
-fn draw(
-    buf: &mut [u8],
-    size: (u32, u32),
-    path: &Path,
-    title: &str,
-    y_label: &str,
-    series: &[Series],
-    threshold: Option<(f64, &str)>,
-) -> Result<()> {
+fn render(buf: &mut [u8], size: (u32, u32), p: &Plot) -> std::result::Result<(), String> {
+    let e = |x: &dyn std::fmt::Display| x.to_string();
     let root = BitMapBackend::with_buffer(buf, size).into_drawing_area();
-    let err = |e: &dyn std::fmt::Display| anyhow!("plot {}: {e}", path.display());
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let x_max = series.iter().flat_map(|s| s.points.iter().map(|p| p.0)).fold(1.0f64, f64::max);
-    let y_max = series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.1))
-        .chain(threshold.map(|t| t.0))
-        .filter(|v| v.is_finite())
-        .fold(0.0f64, f64::max)
-        .max(1e-3)
-        * 1.1;
+    root.fill(&WHITE).map_err(|x| e(&x))?;
+    let xs = p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0)).filter(|v| v.is_finite());
+    let (x_min, x_max) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    let (x_min, x_max) = if x_min < x_max { (x_min, x_max) } else { (0.0, 1.0) };
+    let (y_min, y_max) = p.y_range.unwrap_or_else(|| {
+        let ys = p.series.iter().flat_map(|s| s.points.iter().map(|q| q.1)).chain(p.threshold.map(|t| t.0));
+        let (lo, hi) = ys.filter(|v| v.is_finite()).fold((0.0f64, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
+        (lo * 1.1, (hi * 1.1).max(lo + 1e-3))
+    });
     let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
+        .caption(p.title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(60)
-        .build_cartesian_2d(0f64..x_max, 0f64..y_max)
-        .map_err(|e| err(&e))?;
-    chart.configure_mesh().x_desc("frame").y_desc(y_label).draw().map_err(|e| err(&e))?;
-    for s in series {
+        .build_cartesian_2d(x_min..x_max, y_min..y_max)
+        .map_err(|x| e(&x))?;
+    chart.configure_mesh().x_desc(p.x_label).y_desc(p.y_label).draw().map_err(|x| e(&x))?;
+    for s in p.series {
         let color = s.color;
         chart
-            .draw_series(LineSeries::new(s.points.iter().copied().filter(|p| p.1.is_finite()), color.stroke_width(2)))
-            .map_err(|e| err(&e))?
+            .draw_series(LineSeries::new(s.points.iter().copied().filter(|q| q.1.is_finite()), color.stroke_width(2)))
+            .map_err(|x| e(&x))?
             .label(s.label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+        chart
+            .draw_series(s.points.iter().filter(|q| q.1.is_finite()).map(|&q| Circle::new(q, 3, color.filled())))
+            .map_err(|x| e(&x))?;
     }
-    if let Some((t, label)) = threshold {
-        let dashes = (0..(x_max as usize * 2)).step_by(2).map(|i| {
-            let x0 = i as f64 / 2.0;
-            PathElement::new(vec![(x0, t), (x0 + 0.5, t)], BLACK.stroke_width(1))
+    if let Some((t, label)) = p.threshold {
+        let n = 100;
+        let dash = (x_max - x_min) / n as f64;
+        let dashes = (0..n).step_by(2).map(|i| {
+            let x0 = x_min + i as f64 * dash;
+            PathElement::new(vec![(x0, t), (x0 + dash, t)], BLACK.stroke_width(1))
         });
         chart
             .draw_series(dashes)
-            .map_err(|e| err(&e))?
+            .map_err(|x| e(&x))?
             .label(label)
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));
     }
-    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))?;
+    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|x| e(&x))?;
+    root.present().map_err(|x| e(&x))?;
     Ok(())
 }
