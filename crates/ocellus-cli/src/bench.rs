@@ -17,6 +17,8 @@ pub enum Target {
     /// Surprise, chaos and attention per frame on top of saliency (640x480, one core), and
     /// end-to-end fps of `ocellus attend` from video files, decode included.
     Attention,
+    /// One view-direction decision: 19 candidate pans, a 40x30 surprise map (microseconds).
+    Planning,
 }
 
 /// Arguments of `ocellus bench`.
@@ -168,8 +170,10 @@ pub fn run(a: BenchArgs) -> Result<()> {
     if a.frames == 0 {
         bail!("--frames must be at least 1");
     }
-    if let Target::Attention = a.target {
-        return crate::bench_attention::run(a.json, a.frames);
+    match a.target {
+        Target::Attention => return crate::bench_attention::run(a.json, a.frames),
+        Target::Planning => return crate::bench_planning::run(a.json, a.frames.max(100)),
+        Target::Saliency => {}
     }
     let backend: Backend = serde_json::from_value(json!(a.backend))
         .with_context(|| format!("unknown backend '{}' (auto, scalar, avx2)", a.backend))?;
