@@ -322,3 +322,23 @@ fn attend_on_a_cut_video_keeps_the_frames_before_and_names_the_frame() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("no row for frame 2"));
 }
+
+#[test]
+fn plan_corridor_writes_frames_csv_and_plots() {
+    let out = tmpdir("plan");
+    let o = ocellus().args(["plan", "corridor", "--event", "--steps", "7", "--out"]).arg(&out).output().unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{stdout} {}", String::from_utf8_lossy(&o.stderr));
+    let rows = csv_rows(&out.join("steps.csv"));
+    assert_eq!(rows.len(), 7);
+    // 11 fixed columns, then 2 gains for each of the 19 candidate pans.
+    assert_eq!(rows[0].len(), 15 + 2 * 19);
+    let chaos: f64 = rows[5][6].parse().unwrap();
+    let chosen: f64 = rows[5][14].parse().unwrap();
+    let person_next: f64 = rows[5][13].parse().unwrap();
+    assert!(chaos > 1.0 && rows[5][7] == "0", "{:?}", rows[5]);
+    assert!((chosen - person_next).abs() <= 10.0, "chose {chosen}, person at {person_next}");
+    for f in ["angles.png", "gains_step5.png", "frames/step_05.png"] {
+        assert!(out.join(f).metadata().unwrap().len() > 1000, "{f}");
+    }
+}
