@@ -482,6 +482,23 @@ mod tests {
         assert!(p.bottom_up_gain(&weird, 10.0).is_finite());
     }
 
+    proptest::proptest! {
+        #[test]
+        fn bottom_up_and_decisions_are_finite_for_any_map(
+            w in 0usize..12, h in 0usize..9, vals in proptest::collection::vec(proptest::num::f32::ANY, 108),
+            shift in proptest::num::f64::ANY, chaos in proptest::num::f64::ANY,
+        ) {
+            let map = Plane::from_fn(w, h, |x, y| vals[(y * 12 + x) % vals.len()]);
+            let mut p = planner();
+            let g = p.bottom_up_gain(&map, shift);
+            proptest::prop_assert!(g.is_finite() && g >= 0.0);
+            let (mu, cov) = (Vector2::new(1.0, 1.25), Matrix2::new(0.01, 0.0, 0.0, 0.01));
+            let d = p.decide(&mu, &cov, 0.0, 0.0, &map, chaos).unwrap();
+            proptest::prop_assert!(d.pan_deg.is_finite());
+            proptest::prop_assert!(d.candidates.iter().all(|c| c.score.is_finite()));
+        }
+    }
+
     #[test]
     fn top_down_prefers_directions_with_landmarks() {
         let p = planner();
