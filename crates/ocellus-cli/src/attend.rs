@@ -28,15 +28,8 @@ pub struct AttendArgs {
     /// Output folder.
     #[arg(long, default_value = "ocellus-attend")]
     pub out: PathBuf,
-    /// Saliency preset (ace2009 or stb); a flicker channel is added.
-    #[arg(long, default_value = "ace2009")]
-    pub preset: String,
-    /// TOML file overriding preset fields (as `ocellus saliency --config`).
-    #[arg(long)]
-    pub config: Option<PathBuf>,
-    /// Use the 5-model multi-timescale surprise (iLab) instead of the single model.
-    #[arg(long)]
-    pub surprise_chain: bool,
+    #[command(flatten)]
+    pub stream: StreamOptions,
     /// Do not write per-frame overlay PNGs (the video, CSVs and plot are still written).
     #[arg(long)]
     pub no_overlays: bool,
@@ -46,6 +39,38 @@ pub struct AttendArgs {
     /// Process at most N frames.
     #[arg(long)]
     pub limit: Option<usize>,
+}
+
+/// Options shared by the commands that run the stream engine.
+#[derive(Args, Debug, Clone)]
+pub struct StreamOptions {
+    /// Saliency preset (ace2009 or stb); a flicker channel is added.
+    #[arg(long, default_value = "ace2009")]
+    pub preset: String,
+    /// TOML file overriding preset fields (as `ocellus saliency --config`).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// Use the 5-model multi-timescale surprise (iLab) instead of the single model.
+    #[arg(long)]
+    pub surprise_chain: bool,
+}
+
+impl StreamOptions {
+    /// The stream configuration, for a camera of `deg_per_px` degrees per pixel.
+    pub fn config(&self, deg_per_px: f32) -> Result<StreamConfig> {
+        Ok(StreamConfig {
+            saliency: config_file::load(&self.preset, self.config.as_deref())?,
+            surprise: if self.surprise_chain { SurpriseConfig::chain() } else { SurpriseConfig::default() },
+            deg_per_px,
+            ..StreamConfig::default()
+        })
+    }
+}
+
+impl Default for StreamOptions {
+    fn default() -> Self {
+        Self { preset: "ace2009".into(), config: None, surprise_chain: false }
+    }
 }
 
 /// Where per-frame results go.
@@ -201,16 +226,6 @@ fn composite(frame: &RgbImage, r: &StreamFrame, recent: &[Fixation]) -> Result<P
     Ok(overlay::grid2x2([&view, &sal, &sur, &inh]))
 }
 
-/// The stream configuration of `attend` and `surprise`.
-pub fn stream_config(preset: &str, config: Option<&Path>, chain: bool, deg_per_px: f32) -> Result<StreamConfig> {
-    Ok(StreamConfig {
-        saliency: config_file::load(preset, config)?,
-        surprise: if chain { SurpriseConfig::chain() } else { SurpriseConfig::default() },
-        deg_per_px,
-        ..StreamConfig::default()
-    })
-}
-
 /// Runs the subcommand.
 pub fn run(a: AttendArgs) -> Result<()> {
     let out = a.out.clone();
@@ -221,7 +236,7 @@ pub fn run(a: AttendArgs) -> Result<()> {
 
 /// Runs the subcommand without the summary line: (frames, saccades, files written).
 pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
-    let cfg = stream_config(&a.preset, a.config.as_deref(), a.surprise_chain, a.deg_per_px)?;
+    let cfg = a.stream.config(a.deg_per_px)?;
     let pan_tilt = a.pan_tilt.as_deref().map(frames::read_pan_tilt).transpose()?;
     let mut out = Outputs::new(&a.out, !a.no_overlays)?;
     let mut engine: Option<StreamEngine> = None;

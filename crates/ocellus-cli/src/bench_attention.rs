@@ -1,7 +1,7 @@
 //! `ocellus bench attention`: the per-frame cost of surprise, chaos and attention on top of
 //! saliency, and end-to-end frames per second of `ocellus attend` from video files.
 
-use crate::attend::{self, AttendArgs};
+use crate::attend::{self, AttendArgs, StreamOptions};
 use crate::bench::{median, peak_rss_mb};
 use crate::generate::scene;
 use anyhow::Result;
@@ -97,9 +97,7 @@ fn attend_fps(video: &Path, out: &Path, overlays: bool) -> Result<f64> {
         pan_tilt: None,
         deg_per_px: 0.1,
         out: out.into(),
-        preset: "ace2009".into(),
-        config: None,
-        surprise_chain: false,
+        stream: StreamOptions::default(),
         no_overlays: !overlays,
         fps: 30,
         limit: None,

@@ -1,6 +1,6 @@
 //! `ocellus demo`: the main capabilities end to end on the built-in images.
 
-use crate::attend::{self, AttendArgs};
+use crate::attend::{self, AttendArgs, StreamOptions};
 use crate::{assets, generate, inputs, saliency_cmd};
 use anyhow::{Context, Result};
 use clap::Args;
@@ -59,9 +59,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
         pan_tilt: Some(seq.join("pan_tilt.csv")),
         deg_per_px: 0.1,
         out: dir.join("attend"),
-        preset: "ace2009".into(),
-        config: None,
-        surprise_chain: false,
+        stream: StreamOptions::default(),
         no_overlays: false,
         fps: 30,
         limit: None,

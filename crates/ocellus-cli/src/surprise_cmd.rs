@@ -1,6 +1,6 @@
 //! `ocellus surprise`: Bayesian surprise maps of a video or image sequence.
 
-use crate::attend::stream_config;
+use crate::attend::StreamOptions;
 use crate::{frames, overlay};
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -17,15 +17,8 @@ pub struct SurpriseArgs {
     /// Output folder: surprise/frame_NNNNN.png (and .npy with --npy), surprise.csv.
     #[arg(long, default_value = "ocellus-surprise")]
     pub out: PathBuf,
-    /// Saliency preset (ace2009 or stb); a flicker channel is added.
-    #[arg(long, default_value = "ace2009")]
-    pub preset: String,
-    /// TOML file overriding preset fields.
-    #[arg(long)]
-    pub config: Option<PathBuf>,
-    /// Use the 5-model multi-timescale surprise (iLab) instead of the single model.
-    #[arg(long)]
-    pub chain: bool,
+    #[command(flatten)]
+    pub stream: StreamOptions,
     /// Also write each surprise map (bits, map level) as NumPy .npy.
     #[arg(long)]
     pub npy: bool,
@@ -36,7 +29,7 @@ pub struct SurpriseArgs {
 
 /// Runs the subcommand.
 pub fn run(a: SurpriseArgs) -> Result<()> {
-    let cfg = stream_config(&a.preset, a.config.as_deref(), a.chain, 0.1)?;
+    let cfg = a.stream.config(0.1)?;
     let maps = a.out.join("surprise");
     std::fs::create_dir_all(&maps).with_context(|| format!("cannot create {}", maps.display()))?;
     let csv_path = a.out.join("surprise.csv");

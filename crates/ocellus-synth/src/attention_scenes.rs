@@ -13,6 +13,7 @@
 //! Every frame gets independent Gaussian sensor noise of `noise_sigma` grey levels per channel
 //! (seeded by the configuration's seed and the frame index), then is rounded to 8 bits.
 
+use crate::texture::sample;
 use crate::{Result, SynthError};
 use ocellus_image::convert::RgbImage;
 use ocellus_image::rng::SplitMix64;
@@ -148,29 +149,14 @@ pub struct SceneGenerator {
     object: Plane<[f32; 3]>,
 }
 
-/// Bilinear sample with clamped borders; `wrap_x` wraps x around the width instead.
-fn sample(img: &Plane<[f32; 3]>, x: f32, y: f32, wrap_x: bool) -> [f32; 3] {
-    let (w, h) = (img.width() as isize, img.height() as isize);
-    let (fx, fy) = (x.floor(), y.floor());
-    let (ax, ay) = (x - fx, y - fy);
-    let col = |i: isize| if wrap_x { i.rem_euclid(w) as usize } else { i.clamp(0, w - 1) as usize };
-    let row = |j: isize| j.clamp(0, h - 1) as usize;
-    let (x0, y0) = (fx as isize, fy as isize);
-    let (c0, c1, r0, r1) = (col(x0), col(x0 + 1), row(y0), row(y0 + 1));
-    let (p00, p10, p01, p11) = (img.get(c0, r0), img.get(c1, r0), img.get(c0, r1), img.get(c1, r1));
-    std::array::from_fn(|k| {
-        let top = p00[k] + ax * (p10[k] - p00[k]);
-        let bot = p01[k] + ax * (p11[k] - p01[k]);
-        top + ay * (bot - top)
-    })
-}
-
 /// `img` scaled to `w` x `h` (bilinear, pixel centres aligned).
 fn scaled(img: &RgbImage, w: usize, h: usize) -> Plane<[f32; 3]> {
     let (iw, ih) = img.size();
     let src = Plane::from_fn(iw, ih, |x, y| img.get_f32(x, y));
     let (sx, sy) = (iw as f32 / w as f32, ih as f32 / h as f32);
-    Plane::from_fn(w, h, |x, y| sample(&src, (x as f32 + 0.5) * sx - 0.5, (y as f32 + 0.5) * sy - 0.5, false))
+    Plane::from_fn(w, h, |x, y| {
+        sample(&src, ((x as f32 + 0.5) * sx - 0.5) as f64, ((y as f32 + 0.5) * sy - 0.5) as f64, false, false)
+    })
 }
 
 impl SceneGenerator {
@@ -269,7 +255,7 @@ impl SceneGenerator {
                 Some(r) if (r.x..r.x + r.w).contains(&x) && (r.y..r.y + r.h).contains(&y) => {
                     self.object.get(x - r.x, y - r.y)
                 }
-                _ => sample(&self.world, off + x as f32, y as f32, true),
+                _ => sample(&self.world, (off + x as f32) as f64, y as f64, true, false),
             };
             if sigma > 0.0 {
                 p.iter_mut().for_each(|v| *v += sigma * rng.normal() as f32);

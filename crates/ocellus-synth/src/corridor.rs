@@ -12,6 +12,7 @@
 //! wall, floor or ceiling at that height. Textures are sampled bilinearly; optional Gaussian
 //! sensor noise is seeded per frame.
 
+use crate::texture::sample;
 use crate::{Result, SynthError};
 use ocellus_image::convert::RgbImage;
 use ocellus_image::rng::SplitMix64;
@@ -129,21 +130,6 @@ pub struct Corridor {
 fn to_f32(img: &RgbImage) -> Plane<[f32; 3]> {
     let (w, h) = img.size();
     Plane::from_fn(w, h, |x, y| img.get_f32(x, y))
-}
-
-/// Bilinear sample at texture coordinates (u, v) in pixels; wraps when `wrap`, else clamps.
-fn sample(t: &Plane<[f32; 3]>, u: f64, v: f64, wrap: bool) -> [f32; 3] {
-    let (w, h) = (t.width() as i64, t.height() as i64);
-    let (fu, fv) = (u.floor(), v.floor());
-    let (au, av) = ((u - fu) as f32, (v - fv) as f32);
-    let idx = |i: i64, n: i64| if wrap { i.rem_euclid(n) as usize } else { i.clamp(0, n - 1) as usize };
-    let (x0, x1, y0, y1) = (idx(fu as i64, w), idx(fu as i64 + 1, w), idx(fv as i64, h), idx(fv as i64 + 1, h));
-    let (a, b, c, d) = (t.get(x0, y0), t.get(x1, y0), t.get(x0, y1), t.get(x1, y1));
-    std::array::from_fn(|k| {
-        let top = a[k] + au * (b[k] - a[k]);
-        let bot = c[k] + au * (d[k] - c[k]);
-        top + av * (bot - top)
-    })
 }
 
 impl Corridor {
@@ -264,7 +250,7 @@ impl Corridor {
                     if (0.0..p.height_m).contains(&z) {
                         let tu = s / p.width_m * self.person.width() as f64 - 0.5;
                         let tv = (p.height_m - z) / p.height_m * self.person.height() as f64 - 0.5;
-                        px = Some(sample(&self.person, self.person.width() as f64 - 1.0 - tu, tv, false));
+                        px = Some(sample(&self.person, self.person.width() as f64 - 1.0 - tu, tv, false, false));
                     }
                 }
                 let px = px.unwrap_or_else(|| {
@@ -273,7 +259,7 @@ impl Corridor {
                         // Floor: where the ray meets z = 0.
                         let t = c.camera_height_m / (-slope * cos_off);
                         let (fx, fy) = (x_m + t * dx, y_m + t * dy);
-                        sample(&self.floor, fx * c.texture_px_per_m, fy * c.texture_px_per_m, true)
+                        sample(&self.floor, fx * c.texture_px_per_m, fy * c.texture_px_per_m, true, true)
                     } else if z > c.wall_height_m {
                         [0.82, 0.82, 0.80]
                     } else {
@@ -305,12 +291,12 @@ impl Corridor {
                     // Seen from inside the corridor the left wall runs right to left.
                     let fu = if wall == Wall::Left { 0.5 - ds / p.size_m } else { 0.5 + ds / p.size_m };
                     let fv = 0.5 - dz / p.size_m;
-                    return sample(t, fu * t.width() as f64 - 0.5, fv * t.height() as f64 - 0.5, false);
+                    return sample(t, fu * t.width() as f64 - 0.5, fv * t.height() as f64 - 0.5, false, false);
                 }
             }
         }
         let k = c.texture_px_per_m;
-        sample(&self.wall, s * k, (c.wall_height_m - z) * k, true)
+        sample(&self.wall, s * k, (c.wall_height_m - z) * k, true, true)
     }
 }
 

@@ -24,6 +24,7 @@
 
 pub mod attention_scenes;
 pub mod corridor;
+pub mod texture;
 
 use thiserror::Error;
 
