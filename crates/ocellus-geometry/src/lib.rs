@@ -7,6 +7,8 @@
 //!   normalized SVD form (Hartley); reprojection errors; decomposition of P into K, R, t.
 //! - [`triangulate`]: points from two views (the seed's 4x3 least squares) and from N views (SVD).
 //! - [`stereo`]: parallel stereo with explicit units (disparity, depth, pixel sizes).
+//! - [`block_matching`]: dense disparity by SAD block matching with uniqueness and
+//!   left-right checks; the bad-pixel rate against ground truth.
 //!
 //! Conventions: world and camera frames are right-handed; the camera looks along its +z axis,
 //! x right, y down in the image; pixel centres at integer coordinates, (0, 0) the top-left
@@ -20,6 +22,7 @@
 //! assert!((rig.depth(10.0).unwrap() - 10.24).abs() < 1e-12);
 //! ```
 
+pub mod block_matching;
 pub mod camera;
 pub mod distortion;
 pub mod dlt;
