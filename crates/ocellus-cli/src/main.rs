@@ -16,6 +16,7 @@ mod overlay;
 mod plan_cmd;
 mod plot;
 mod saliency_cmd;
+mod stereo_cmd;
 mod surprise_cmd;
 mod video_out;
 
@@ -52,6 +53,9 @@ enum Command {
     /// Information-based view-direction planning in a simulated corridor (top-down landmarks
     /// vs bottom-up surprise, switched by the context chaos degree).
     Plan(plan_cmd::PlanArgs),
+    /// Dense disparity of a rectified stereo pair by block matching; depth and a point cloud
+    /// with calibration; bad-2.0 against a ground-truth PFM.
+    Stereo(stereo_cmd::StereoArgs),
     /// Generate ground-truth sequences from the built-in real images.
     Generate(generate::GenerateArgs),
     /// Print benchmark figures (median ms per frame, fps on all cores, per stage, peak memory).
@@ -59,6 +63,13 @@ enum Command {
 }
 
 fn main() {
+    // Behave like other command-line programs when the reader of stdout goes away
+    // (`ocellus ... | head`): end quietly instead of panicking on the write.
+    #[cfg(unix)]
+    // SAFETY: restoring the default action of SIGPIPE before any thread is started.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     let r: Result<()> = match cli.command {
         Command::Demo(a) => demo::run(a),
@@ -69,6 +80,7 @@ fn main() {
         Command::Surprise(a) => surprise_cmd::run(a),
         Command::Generate(a) => generate::run(a),
         Command::Plan(a) => plan_cmd::run(a),
+        Command::Stereo(a) => stereo_cmd::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

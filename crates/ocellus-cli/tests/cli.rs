@@ -342,3 +342,34 @@ fn plan_corridor_writes_frames_csv_and_plots() {
         assert!(out.join(f).metadata().unwrap().len() > 1000, "{f}");
     }
 }
+
+#[test]
+fn stereo_writes_disparity_depth_cloud_and_scores_against_truth() {
+    let d = ocellus_testdata::data_dir().expect("shared data");
+    let out = tmpdir("stereo");
+    let o = ocellus()
+        .arg("stereo")
+        .arg(d.join("motorcycle_left.png"))
+        .arg(d.join("motorcycle_right.png"))
+        .arg("--truth")
+        .arg(d.join("motorcycle_disp.pfm"))
+        .args(["--focal-px", "994.978", "--baseline", "193.001", "--doffs", "31.086", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{s} {}", String::from_utf8_lossy(&o.stderr));
+    let bad: f64 = s.split("bad-2.0 ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap();
+    assert!(bad < 27.0, "{s}");
+    let depth = ocellus_io::pfm::read(out.join("depth.pfm")).unwrap();
+    let disp = ocellus_io::pfm::read(out.join("disparity.pfm")).unwrap();
+    // Z = b f / (d + doffs) in millimetres, where a disparity exists.
+    let (x, y) = (400, 250);
+    let want = 193.001 * 994.978 / (disp.get(x, y) as f64 + 31.086);
+    assert!((depth.get(x, y) as f64 - want).abs() < 1e-2 * want, "{} vs {want}", depth.get(x, y));
+    assert!(out.join("points.ply").metadata().unwrap().len() > 100_000);
+    // Images of different sizes are a clear error.
+    let o = ocellus().arg("stereo").arg(d.join("motorcycle_left.png")).arg(d.join("coffee.png")).output().unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("differ in size"));
+}

@@ -5,6 +5,7 @@
 //! - [`npy`]: NumPy `.npy` arrays (read f32/f64 in C or Fortran order; write f32, C order).
 //! - [`pfm`]: Portable Float Map, single channel, as Middlebury writes it (rows bottom-up).
 //! - [`points`]: CSV files of 2D points (fixations), in pixels.
+//! - [`ply`]: coloured point clouds.
 //! - [`video`]: frame sources (image folders, Y4M, any video through the ffmpeg program) and
 //!   [`y4m`] reading and writing.
 //!
@@ -21,6 +22,7 @@
 
 pub mod npy;
 pub mod pfm;
+pub mod ply;
 pub mod points;
 pub mod video;
 pub mod y4m;
