@@ -19,6 +19,8 @@ pub enum Target {
     Attention,
     /// One view-direction decision: 19 candidate pans, a 40x30 surprise map (microseconds).
     Planning,
+    /// DLT from 100 points, triangulation of 100k points, block matching at 741x500.
+    Geometry,
 }
 
 /// Arguments of `ocellus bench`.
@@ -173,6 +175,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
     match a.target {
         Target::Attention => return crate::bench_attention::run(a.json, a.frames),
         Target::Planning => return crate::bench_planning::run(a.json, a.frames.max(100)),
+        Target::Geometry => return crate::bench_geometry::run(a.json, 5),
         Target::Saliency => {}
     }
     let backend: Backend = serde_json::from_value(json!(a.backend))

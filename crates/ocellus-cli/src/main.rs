@@ -4,6 +4,7 @@ mod assets;
 mod attend;
 mod bench;
 mod bench_attention;
+mod bench_geometry;
 mod bench_planning;
 mod config_file;
 mod corridor_sim;
