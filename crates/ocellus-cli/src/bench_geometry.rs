@@ -19,8 +19,16 @@ fn ms(t: Instant) -> f64 {
 /// Runs the benchmark; `reps` repetitions of each timing (median reported).
 pub fn run(json_out: bool, reps: usize) -> Result<()> {
     let k = Intrinsics { fx: 810.0, fy: 790.0, cx: 322.0, cy: 236.0, skew: 0.0 };
-    let c1 = PinholeCamera { k, r: *Rotation3::from_euler_angles(0.2, -0.3, 0.1).matrix(), t: Vector3::new(0.05, -0.1, 2.0) };
-    let c2 = PinholeCamera { k, r: *Rotation3::from_euler_angles(0.2, -0.1, 0.1).matrix(), t: Vector3::new(-0.4, -0.1, 2.0) };
+    let c1 = PinholeCamera {
+        k,
+        r: *Rotation3::from_euler_angles(0.2, -0.3, 0.1).matrix(),
+        t: Vector3::new(0.05, -0.1, 2.0),
+    };
+    let c2 = PinholeCamera {
+        k,
+        r: *Rotation3::from_euler_angles(0.2, -0.1, 0.1).matrix(),
+        t: Vector3::new(-0.4, -0.1, 2.0),
+    };
     let mut rng = SplitMix64::new(9);
     let mut pts = Vec::new();
     while pts.len() < 100_000 {

@@ -102,7 +102,7 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
             }
         }
     }
-    // cost[x * nd + d] for the current row.
+    // cost[d * w + x] for the current row (contiguous per disparity for the box sums).
     let big = u32::MAX / 4;
     let mut cost = vec![big; w * nd];
     for y in r..h - r {
@@ -128,15 +128,19 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
                 continue;
             }
             let mut s: u32 = cs[x0 - r..=x0 + r].iter().sum();
-            cost[x0 * nd + d] = s;
+            let out = &mut cost[d * w..(d + 1) * w];
+            out[x0] = s;
             for x in x0 + 1..w - r {
                 s = s + cs[x + r] - cs[x - r - 1];
-                cost[x * nd + d] = s;
+                out[x] = s;
             }
         }
         let row = out.row_mut(y);
+        let mut c = vec![0u32; nd];
         for x in (nd - 1 + r)..w - r {
-            let c = &cost[x * nd..(x + 1) * nd];
+            for (d, v) in c.iter_mut().enumerate() {
+                *v = cost[d * w + x];
+            }
             let (best_d, best) =
                 c.iter().enumerate().fold((0, u32::MAX), |b, (d, &v)| if v < b.1 { (d, v) } else { b });
             if best >= big {
@@ -153,7 +157,7 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
                 let xr = x - best_d;
                 let (rd, _) = (0..nd)
                     .filter(|&d| xr + d < w)
-                    .map(|d| (d, cost[(xr + d) * nd + d]))
+                    .map(|d| (d, cost[d * w + xr + d]))
                     .fold((0, u32::MAX), |b, (d, v)| if v < b.1 { (d, v) } else { b });
                 if (rd as f32 - best_d as f32).abs() > p.lr_max_diff {
                     continue;
