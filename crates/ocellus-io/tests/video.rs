@@ -42,6 +42,12 @@ fn ffmpeg(args: &[&str]) {
     assert!(o.status.success(), "ffmpeg {args:?}: {}", String::from_utf8_lossy(&o.stderr));
 }
 
+/// Encodes the numbered PNGs of `pattern` with `codec` and `pix_fmt` into `out`.
+fn encode_pngs(pattern: &Path, codec: &str, pix_fmt: &str, out: &Path) {
+    let (p, o) = (pattern.to_str().unwrap(), out.to_str().unwrap());
+    ffmpeg(&["-framerate", "30", "-i", p, "-c:v", codec, "-pix_fmt", pix_fmt, o]);
+}
+
 fn read_all(path: &Path) -> (Vec<RgbImage>, Option<usize>) {
     let mut f = Frames::open(path).unwrap();
     let hint = f.len_hint();
@@ -75,17 +81,7 @@ fn folder_y4m_and_ffmpeg_sources_deliver_the_same_frames() {
     // Lossless RGB video through ffmpeg: exact.
     let pattern = pngs.join("f%d.png");
     let mkv = dir.join("lossless.mkv");
-    ffmpeg(&[
-        "-framerate",
-        "30",
-        "-i",
-        pattern.to_str().unwrap(),
-        "-c:v",
-        "ffv1",
-        "-pix_fmt",
-        "bgr0",
-        mkv.to_str().unwrap(),
-    ]);
+    encode_pngs(&pattern, "ffv1", "bgr0", &mkv);
     let (got, _) = read_all(&mkv);
     assert_eq!(got.len(), 8);
     assert!(got.iter().zip(&want).all(|(g, w)| max_diff(g, w) == 0));
@@ -135,17 +131,7 @@ fn truncated_and_corrupt_videos_fail_at_the_right_frame() {
     write_pngs(&want, &pngs);
     let nut = dir.join("raw.nut");
     let pattern = pngs.join("f%d.png");
-    ffmpeg(&[
-        "-framerate",
-        "30",
-        "-i",
-        pattern.to_str().unwrap(),
-        "-c:v",
-        "rawvideo",
-        "-pix_fmt",
-        "rgb24",
-        nut.to_str().unwrap(),
-    ]);
+    encode_pngs(&pattern, "rawvideo", "rgb24", &nut);
     let full = std::fs::read(&nut).unwrap();
     let cut = dir.join("cut.nut");
     std::fs::write(&cut, &full[..full.len() * 5 / 8 + 500]).unwrap();
