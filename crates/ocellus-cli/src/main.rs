@@ -6,6 +6,7 @@ mod bench;
 mod bench_attention;
 mod bench_geometry;
 mod bench_planning;
+mod calibrate_cmd;
 mod config_file;
 mod corridor_sim;
 mod demo;
@@ -54,6 +55,8 @@ enum Command {
     /// Information-based view-direction planning in a simulated corridor (top-down landmarks
     /// vs bottom-up surprise, switched by the context chaos degree).
     Plan(plan_cmd::PlanArgs),
+    /// Camera calibration: `dlt` from 3D-2D correspondences (writes K, R, t, P and errors).
+    Calibrate(calibrate_cmd::CalibrateArgs),
     /// Dense disparity of a rectified stereo pair by block matching; depth and a point cloud
     /// with calibration; bad-2.0 against a ground-truth PFM.
     Stereo(stereo_cmd::StereoArgs),
@@ -82,6 +85,7 @@ fn main() {
         Command::Generate(a) => generate::run(a),
         Command::Plan(a) => plan_cmd::run(a),
         Command::Stereo(a) => stereo_cmd::run(a),
+        Command::Calibrate(a) => calibrate_cmd::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

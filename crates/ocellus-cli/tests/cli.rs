@@ -373,3 +373,34 @@ fn stereo_writes_disparity_depth_cloud_and_scores_against_truth() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("differ in size"));
 }
+
+#[test]
+fn calibrate_dlt_recovers_a_known_camera_from_csv() {
+    let dir = tmpdir("calib");
+    // A camera 2 m from the world origin (millimetres), fx 810, fy 790, (322, 236).
+    let mut csv = String::from("X,Y,Z,u,v\n");
+    for i in 0..30 {
+        let (x, y, z) = (
+            ((i * 37) % 17) as f64 * 50.0 - 400.0,
+            ((i * 11) % 13) as f64 * 60.0 - 360.0,
+            ((i * 7) % 11) as f64 * 70.0 - 350.0,
+        );
+        let zc = z + 2000.0;
+        csv.push_str(&format!("{x},{y},{z},{},{}\n", 810.0 * x / zc + 322.0, 790.0 * y / zc + 236.0));
+    }
+    let pts = dir.join("pts.csv");
+    std::fs::write(&pts, csv).unwrap();
+    let out = dir.join("camera.json");
+    let o = ocellus().args(["calibrate", "dlt"]).arg(&pts).arg("--out").arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    let k = &v["intrinsics"];
+    for (key, want) in [("fx", 810.0), ("fy", 790.0), ("cx", 322.0), ("cy", 236.0)] {
+        assert!((k[key].as_f64().unwrap() - want).abs() < 1e-6, "{key}: {}", k[key]);
+    }
+    assert!((v["translation_world_to_camera"][2].as_f64().unwrap() - 2000.0).abs() < 1e-6);
+    // Coplanar points are a clear error.
+    std::fs::write(&pts, "0,0,0,1,1\n1,0,0,2,1\n0,1,0,1,2\n1,1,0,2,2\n2,1,0,3,2\n1,2,0,2,3\n3,3,0,4,4\n").unwrap();
+    let o = ocellus().args(["calibrate", "dlt"]).arg(&pts).arg("--out").arg(&out).output().unwrap();
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("coplanar"));
+}
