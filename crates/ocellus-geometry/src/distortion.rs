@@ -79,6 +79,52 @@ impl Distortion {
     }
 }
 
+/// Remap tables that undistort whole images: for each pixel (x, y) of the undistorted image of
+/// camera `k`, the position `(map_x, map_y)` in the distorted image to sample (bilinear). Built
+/// once per camera; applying it is one pass over the image ([`remap_bilinear`]).
+pub fn undistort_maps(
+    k: &Intrinsics,
+    d: &Distortion,
+    width: usize,
+    height: usize,
+) -> (ocellus_image::Plane<f32>, ocellus_image::Plane<f32>) {
+    let mut mx = ocellus_image::Plane::new(width, height);
+    let mut my = ocellus_image::Plane::new(width, height);
+    for y in 0..height {
+        for x in 0..width {
+            let (u, v) = d.distort_pixel(k, x as f64, y as f64);
+            mx.set(x, y, u as f32);
+            my.set(x, y, v as f32);
+        }
+    }
+    (mx, my)
+}
+
+/// Samples `src` at the positions of the maps (bilinear; outside the image gives `fill`).
+pub fn remap_bilinear(
+    src: &ocellus_image::Plane<f32>,
+    map_x: &ocellus_image::Plane<f32>,
+    map_y: &ocellus_image::Plane<f32>,
+    fill: f32,
+) -> Result<ocellus_image::Plane<f32>> {
+    if map_x.size() != map_y.size() {
+        return Err(GeometryError::Invalid("remap tables differ in size".into()));
+    }
+    let (w, h) = (src.width() as f32, src.height() as f32);
+    Ok(ocellus_image::Plane::from_fn(map_x.width(), map_x.height(), |x, y| {
+        let (u, v) = (map_x.get(x, y), map_y.get(x, y));
+        if !(u >= 0.0 && v >= 0.0 && u <= w - 1.0 && v <= h - 1.0) {
+            return fill;
+        }
+        let (x0, y0) = (u.floor() as usize, v.floor() as usize);
+        let (x1, y1) = ((x0 + 1).min(src.width() - 1), (y0 + 1).min(src.height() - 1));
+        let (ax, ay) = (u - x0 as f32, v - y0 as f32);
+        let top = src.get(x0, y0) + ax * (src.get(x1, y0) - src.get(x0, y0));
+        let bot = src.get(x0, y1) + ax * (src.get(x1, y1) - src.get(x0, y1));
+        top + ay * (bot - top)
+    }))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -93,6 +139,31 @@ mod tests {
             assert!((uu - u).abs() < 1e-6 && (vu - v).abs() < 1e-6, "({u}, {v}) -> ({uu}, {vu})");
         }
         assert_eq!(Distortion::default().distort(0.3, -0.2), (0.3, -0.2));
+    }
+
+    #[test]
+    fn remap_undoes_a_rendered_distortion() {
+        // Render a smooth image through the distortion (each distorted pixel samples the ideal
+        // image at its undistorted position), then undistort it with the tables.
+        let k = Intrinsics { fx: 200.0, fy: 200.0, cx: 79.5, cy: 59.5, skew: 0.0 };
+        let d = Distortion { k1: -0.2, k2: 0.05, ..Default::default() };
+        let ideal = |x: f64, y: f64| ((x * 0.11).sin() + (y * 0.07).cos()) as f32;
+        let distorted = ocellus_image::Plane::from_fn(160, 120, |x, y| {
+            let (u, v) = d.undistort_pixel(&k, x as f64, y as f64).unwrap();
+            ideal(u, v)
+        });
+        let (mx, my) = undistort_maps(&k, &d, 160, 120);
+        let back = remap_bilinear(&distorted, &mx, &my, f32::NAN).unwrap();
+        let mut worst = 0.0f32;
+        for y in 10..110 {
+            for x in 10..150 {
+                let e = back.get(x, y);
+                if e.is_finite() {
+                    worst = worst.max((e - ideal(x as f64, y as f64)).abs());
+                }
+            }
+        }
+        assert!(worst < 0.01, "worst error {worst}");
     }
 
     #[test]
