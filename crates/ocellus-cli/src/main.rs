@@ -20,6 +20,7 @@ mod plot;
 mod saliency_cmd;
 mod stereo_cmd;
 mod surprise_cmd;
+mod triangulate_cmd;
 mod video_out;
 
 use anyhow::Result;
@@ -57,6 +58,9 @@ enum Command {
     Plan(plan_cmd::PlanArgs),
     /// Camera calibration: `dlt` from 3D-2D correspondences (writes K, R, t, P and errors).
     Calibrate(calibrate_cmd::CalibrateArgs),
+    /// 3D points from pixel matches in two or more calibrated cameras (camera JSON files of
+    /// `ocellus calibrate dlt`); flags points behind a camera.
+    Triangulate(triangulate_cmd::TriangulateArgs),
     /// Dense disparity of a rectified stereo pair by block matching; depth and a point cloud
     /// with calibration; bad-2.0 against a ground-truth PFM.
     Stereo(stereo_cmd::StereoArgs),
@@ -86,6 +90,7 @@ fn main() {
         Command::Plan(a) => plan_cmd::run(a),
         Command::Stereo(a) => stereo_cmd::run(a),
         Command::Calibrate(a) => calibrate_cmd::run(a),
+        Command::Triangulate(a) => triangulate_cmd::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

@@ -404,3 +404,65 @@ fn calibrate_dlt_recovers_a_known_camera_from_csv() {
     let o = ocellus().args(["calibrate", "dlt"]).arg(&pts).arg("--out").arg(&out).output().unwrap();
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("coplanar"));
 }
+
+#[test]
+fn calibrate_two_cameras_then_triangulate_their_matches() {
+    let dir = tmpdir("tri");
+    // Two cameras 2 m away, the second 300 mm to the right; world in millimetres.
+    let project = |x: f64, y: f64, z: f64, shift: f64| {
+        let zc = z + 2000.0;
+        (810.0 * (x - shift) / zc + 322.0, 790.0 * y / zc + 236.0)
+    };
+    let world: Vec<(f64, f64, f64)> = (0..30)
+        .map(|i| {
+            (
+                ((i * 37) % 17) as f64 * 50.0 - 400.0,
+                ((i * 11) % 13) as f64 * 60.0 - 360.0,
+                ((i * 7) % 11) as f64 * 70.0 - 350.0,
+            )
+        })
+        .collect();
+    let mut cams = Vec::new();
+    for (c, shift) in [(0, 0.0), (1, 300.0)] {
+        let mut csv = String::new();
+        for &(x, y, z) in &world {
+            let (u, v) = project(x, y, z, shift);
+            csv.push_str(&format!("{x},{y},{z},{u},{v}\n"));
+        }
+        let (pts, cam) = (dir.join(format!("pts{c}.csv")), dir.join(format!("cam{c}.json")));
+        std::fs::write(&pts, csv).unwrap();
+        let o = ocellus().args(["calibrate", "dlt"]).arg(&pts).arg("--out").arg(&cam).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        cams.push(cam);
+    }
+    let probe = [(10.0, 20.0, 30.0), (-150.0, 80.0, 200.0)];
+    let mut matches = String::from("u1,v1,u2,v2\n");
+    for &(x, y, z) in &probe {
+        let ((a, b), (c, d)) = (project(x, y, z, 0.0), project(x, y, z, 300.0));
+        matches.push_str(&format!("{a},{b},{c},{d}\n"));
+    }
+    std::fs::write(dir.join("m.csv"), matches).unwrap();
+    for seed in [false, true] {
+        let out = dir.join(format!("points{seed}.csv"));
+        let mut cmd = ocellus();
+        cmd.arg("triangulate")
+            .arg("--camera")
+            .arg(&cams[0])
+            .arg("--camera")
+            .arg(&cams[1])
+            .arg(dir.join("m.csv"))
+            .arg("--out")
+            .arg(&out);
+        if seed {
+            cmd.arg("--seed-form");
+        }
+        let o = cmd.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let rows = csv_rows(&out);
+        for (r, &(x, y, z)) in rows.iter().zip(&probe) {
+            let p: Vec<f64> = r[..3].iter().map(|v| v.parse().unwrap()).collect();
+            assert!((p[0] - x).abs() < 1e-3 && (p[1] - y).abs() < 1e-3 && (p[2] - z).abs() < 1e-3, "{r:?}");
+            assert_eq!(r[3], "1");
+        }
+    }
+}

@@ -1,0 +1,103 @@
+//! `ocellus triangulate`: 3D points from pixel matches in calibrated views.
+
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use nalgebra::{Matrix3x4, Vector4};
+use ocellus_geometry::triangulate::{n_view, two_view_seed};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `ocellus triangulate`.
+#[derive(Args, Debug)]
+pub struct TriangulateArgs {
+    /// Camera files written by `ocellus calibrate dlt` (their `projection_matrix`), two or more.
+    #[arg(long = "camera", required = true, num_args = 1)]
+    pub cameras: Vec<PathBuf>,
+    /// CSV of matches: per line the pixel (u, v) in each camera, in the order of --camera.
+    pub matches: PathBuf,
+    /// Use the seed's 4x3 least squares (two cameras only) instead of the homogeneous form.
+    #[arg(long)]
+    pub seed_form: bool,
+    /// Output CSV: X, Y, Z, in front of every camera (1/0), RMS reprojection error (pixels).
+    #[arg(long, default_value = "points.csv")]
+    pub out: PathBuf,
+}
+
+fn read_camera(path: &Path) -> Result<Matrix3x4<f64>> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let v: serde_json::Value =
+        serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
+    let rows =
+        v["projection_matrix"].as_array().with_context(|| format!("{}: no projection_matrix", path.display()))?;
+    let mut p = Matrix3x4::zeros();
+    if rows.len() != 3 {
+        bail!("{}: projection_matrix must have 3 rows", path.display());
+    }
+    for (i, r) in rows.iter().enumerate() {
+        let r = r
+            .as_array()
+            .filter(|r| r.len() == 4)
+            .with_context(|| format!("{}: rows need 4 numbers", path.display()))?;
+        for (j, x) in r.iter().enumerate() {
+            p[(i, j)] =
+                x.as_f64().filter(|x| x.is_finite()).with_context(|| format!("{}: bad number", path.display()))?;
+        }
+    }
+    Ok(p)
+}
+
+/// Runs the subcommand.
+pub fn run(a: TriangulateArgs) -> Result<()> {
+    if a.cameras.len() < 2 {
+        bail!("triangulation needs at least two --camera files");
+    }
+    if a.seed_form && a.cameras.len() != 2 {
+        bail!("--seed-form works with exactly two cameras");
+    }
+    let ps: Vec<Matrix3x4<f64>> = a.cameras.iter().map(|c| read_camera(c)).collect::<Result<_>>()?;
+    let text = std::fs::read_to_string(&a.matches).with_context(|| format!("cannot read {}", a.matches.display()))?;
+    let mut out = std::io::BufWriter::new(
+        std::fs::File::create(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?,
+    );
+    writeln!(out, "x,y,z,in_front,rms_px")?;
+    let (mut n, mut behind) = (0usize, 0usize);
+    for (line_no, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let v: Vec<Option<f64>> =
+            line.split([',', ';', '\t', ' ']).filter(|s| !s.is_empty()).map(|s| s.parse().ok()).collect();
+        if v.len() < 2 * ps.len() || v[..2 * ps.len()].iter().any(Option::is_none) {
+            if n == 0 && line_no == 0 {
+                continue; // header
+            }
+            bail!("{} line {}: expected {} numbers (u, v per camera)", a.matches.display(), line_no + 1, 2 * ps.len());
+        }
+        let px: Vec<[f64; 2]> =
+            (0..ps.len()).map(|i| [v[2 * i].unwrap_or(f64::NAN), v[2 * i + 1].unwrap_or(f64::NAN)]).collect();
+        let t = if a.seed_form {
+            two_view_seed(&ps[0], px[0], &ps[1], px[1])
+        } else {
+            let views: Vec<_> = ps.iter().zip(&px).map(|(p, x)| (p, *x)).collect();
+            n_view(&views)
+        }
+        .with_context(|| format!("{} line {}", a.matches.display(), line_no + 1))?;
+        let x = Vector4::new(t.point.x, t.point.y, t.point.z, 1.0);
+        let sq: f64 = ps
+            .iter()
+            .zip(&px)
+            .map(|(p, q)| {
+                let h = p * x;
+                (h.x / h.z - q[0]).powi(2) + (h.y / h.z - q[1]).powi(2)
+            })
+            .sum();
+        let rms = (sq / ps.len() as f64).sqrt();
+        writeln!(out, "{},{},{},{},{rms:.6}", t.point.x, t.point.y, t.point.z, u8::from(t.in_front))?;
+        n += 1;
+        behind += usize::from(!t.in_front);
+    }
+    out.flush()?;
+    println!("{n} points triangulated from {} cameras ({behind} behind a camera); wrote {}", ps.len(), a.out.display());
+    Ok(())
+}
