@@ -31,7 +31,7 @@ use clap::{Parser, Subcommand};
 #[command(
     name = "ocellus",
     version,
-    about = "Fast, biologically inspired active vision for robots: saliency, surprise and attention (where to look), and more to come",
+    about = "Fast, biologically inspired active vision for robots: saliency, surprise, attention and view planning (where to look); calibration, triangulation and stereo (where things are)",
     long_about = None
 )]
 struct Cli {
@@ -41,11 +41,12 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run the main capabilities end to end on the built-in images; writes maps and overlays.
+    /// Run the main capabilities end to end on built-in data: saliency maps and overlays, then
+    /// attention over a generated sequence.
     Demo(demo::DemoArgs),
     /// Compute bottom-up saliency maps (Itti-Koch-Niebur) for images or folders of images.
     Saliency(saliency_cmd::SaliencyArgs),
-    /// Score saliency maps against human fixation maps (CC, SIM, KL; MIT benchmark definitions).
+    /// Score saliency maps against human fixations (CC, SIM, KL, NSS, AUCs, IG; MIT benchmark definitions).
     Eval(eval::EvalArgs),
     /// Attention over a video or image sequence: saliency with flicker, surprise, context
     /// chaos, winner-take-all with inhibition of return on an ego-sphere; writes overlays, a
