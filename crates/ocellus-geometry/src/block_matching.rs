@@ -105,17 +105,22 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
     // cost[d * w + x] for the current row (contiguous per disparity for the box sums).
     let big = u32::MAX / 4;
     let mut cost = vec![big; w * nd];
+    let (mut best_v, mut best_d) = (vec![0u32; w], vec![0u32; w]);
+    let (mut right_v, mut right_d) = (vec![0u32; w], vec![0u32; w]);
+    let mut ambiguous = vec![false; w];
     for y in r..h - r {
         if y > r {
             // Slide the column sums down one row.
             let (add, sub) = (y + r, y - r - 1);
             for d in 0..nd {
                 let (la, ra, ls, rs) = (left.row(add), right.row(add), left.row(sub), right.row(sub));
-                let cs = &mut colsum[d * w..(d + 1) * w];
-                for x in d..w {
-                    let a = (la[x] as i32 - ra[x - d] as i32).unsigned_abs();
-                    let s = (ls[x] as i32 - rs[x - d] as i32).unsigned_abs();
-                    cs[x] = cs[x] + a - s;
+                let cs = &mut colsum[d * w + d..(d + 1) * w];
+                // Zipped slices: no bounds checks, so the loop vectorizes.
+                let it = cs.iter_mut().zip(&la[d..]).zip(&ra[..w - d]).zip(ls[d..].iter().zip(&rs[..w - d]));
+                for (((c, &a1), &a2), (&s1, &s2)) in it {
+                    let a = (a1 as i32 - a2 as i32).unsigned_abs();
+                    let s = (s1 as i32 - s2 as i32).unsigned_abs();
+                    *c = *c + a - s;
                 }
             }
         }
@@ -130,43 +135,56 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
             let mut s: u32 = cs[x0 - r..=x0 + r].iter().sum();
             let out = &mut cost[d * w..(d + 1) * w];
             out[x0] = s;
-            for x in x0 + 1..w - r {
-                s = s + cs[x + r] - cs[x - r - 1];
-                out[x] = s;
+            let (adds, subs) = (&cs[x0 + r + 1..], &cs[x0 - r..w - 2 * r - 1]);
+            for ((o, &a), &b) in out[x0 + 1..w - r].iter_mut().zip(adds).zip(subs) {
+                s = s + a - b;
+                *o = s;
+            }
+        }
+        // Per-row passes over the disparities (contiguous, vectorizable), in the order a
+        // per-pixel scan would visit them, so ties resolve the same way (first minimum).
+        best_v.fill(u32::MAX);
+        best_d.fill(0);
+        right_v.fill(u32::MAX);
+        right_d.fill(0);
+        for d in 0..nd {
+            let cd = &cost[d * w..(d + 1) * w];
+            for (x, &v) in cd.iter().enumerate() {
+                if v < best_v[x] {
+                    best_v[x] = v;
+                    best_d[x] = d as u32;
+                }
+            }
+            // Right pixel xr matches left pixel xr + d at disparity d.
+            for (xr, &v) in cd[d..].iter().enumerate() {
+                if v < right_v[xr] {
+                    right_v[xr] = v;
+                    right_d[xr] = d as u32;
+                }
+            }
+        }
+        ambiguous.fill(false);
+        for d in 0..nd {
+            let cd = &cost[d * w..(d + 1) * w];
+            for (x, &v) in cd.iter().enumerate() {
+                let limit = best_v[x] as f32 * (1.0 + p.uniqueness);
+                let far = (d as u32).abs_diff(best_d[x]) > 1;
+                ambiguous[x] |= far && (v as f32) <= limit && v < big;
             }
         }
         let row = out.row_mut(y);
-        let mut c = vec![0u32; nd];
         for x in (nd - 1 + r)..w - r {
-            for (d, v) in c.iter_mut().enumerate() {
-                *v = cost[d * w + x];
-            }
-            let (best_d, best) =
-                c.iter().enumerate().fold((0, u32::MAX), |b, (d, &v)| if v < b.1 { (d, v) } else { b });
-            if best >= big {
+            let (bd, best) = (best_d[x] as usize, best_v[x]);
+            if best >= big || ambiguous[x] {
                 continue;
             }
-            let limit = best as f32 * (1.0 + p.uniqueness);
-            let ambiguous =
-                c.iter().enumerate().any(|(d, &v)| d.abs_diff(best_d) > 1 && (v as f32) <= limit && v < big);
-            if ambiguous {
+            if p.lr_max_diff >= 0.0 && (right_d[x - bd] as f32 - bd as f32).abs() > p.lr_max_diff {
                 continue;
-            }
-            if p.lr_max_diff >= 0.0 {
-                // The right pixel xr = x - best_d: its best disparity over left pixels xr + d.
-                let xr = x - best_d;
-                let (rd, _) = (0..nd)
-                    .filter(|&d| xr + d < w)
-                    .map(|d| (d, cost[d * w + xr + d]))
-                    .fold((0, u32::MAX), |b, (d, v)| if v < b.1 { (d, v) } else { b });
-                if (rd as f32 - best_d as f32).abs() > p.lr_max_diff {
-                    continue;
-                }
             }
             // Sub-pixel: vertex of the parabola through d - 1, d, d + 1.
-            let mut dsub = best_d as f32;
-            if best_d > 0 && best_d + 1 < nd {
-                let (cm, cp) = (c[best_d - 1], c[best_d + 1]);
+            let mut dsub = bd as f32;
+            if bd > 0 && bd + 1 < nd {
+                let (cm, cp) = (cost[(bd - 1) * w + x], cost[(bd + 1) * w + x]);
                 if cm < big && cp < big {
                     let den = cm as f32 + cp as f32 - 2.0 * best as f32;
                     if den > 0.0 {
