@@ -1,6 +1,6 @@
 //! `ocellus calibrate`: camera calibration from correspondences.
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use ocellus_geometry::dlt::{decompose, dlt, dlt_linear, reprojection};
 use serde_json::json;
@@ -33,29 +33,12 @@ struct DltArgs {
     out: PathBuf,
 }
 
+/// 3D points and their pixels.
 type Correspondences = (Vec<[f64; 3]>, Vec<[f64; 2]>);
 
 fn read_correspondences(path: &Path) -> Result<Correspondences> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let (mut p3, mut p2) = (Vec::new(), Vec::new());
-    for (n, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let v: Vec<Option<f64>> =
-            line.split([',', ';', '\t', ' ']).filter(|s| !s.is_empty()).map(|s| s.parse().ok()).collect();
-        if v.len() < 5 || v[..5].iter().any(Option::is_none) {
-            if p3.is_empty() && n == 0 {
-                continue; // header
-            }
-            bail!("{} line {}: expected 'X,Y,Z,u,v', got '{line}'", path.display(), n + 1);
-        }
-        let f: Vec<f64> = v[..5].iter().map(|x| x.unwrap_or(f64::NAN)).collect();
-        p3.push([f[0], f[1], f[2]]);
-        p2.push([f[3], f[4]]);
-    }
-    Ok((p3, p2))
+    let rows = ocellus_io::csv::read_rows(path, 5, "'X,Y,Z,u,v'")?;
+    Ok(rows.iter().map(|r| ([r[0], r[1], r[2]], [r[3], r[4]])).unzip())
 }
 
 /// Runs the subcommand.

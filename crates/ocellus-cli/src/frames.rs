@@ -51,34 +51,14 @@ pub fn for_each_frame(
 /// Camera (pan, tilt) in degrees per frame, from a CSV `frame,pan_deg,tilt_deg` (a header
 /// line allowed). Frames must be listed in order from 0, one row each.
 pub fn read_pan_tilt(path: &Path) -> Result<Vec<(f32, f32)>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let mut out = Vec::new();
-    for (n, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let f: Vec<&str> = line.split(',').map(str::trim).collect();
-        let parsed = (f.first().and_then(|v| v.parse::<usize>().ok()), f.get(1).and_then(|v| v.parse::<f32>().ok()));
-        let (Some(frame), Some(pan)) = parsed else {
-            if out.is_empty() && n == 0 {
-                continue; // header
+    let rows = ocellus_io::csv::read_rows(path, 3, "'frame,pan_deg,tilt_deg'")?;
+    rows.iter()
+        .enumerate()
+        .map(|(k, r)| {
+            if r[0] != k as f64 {
+                bail!("{}: row {} is frame {}, expected frame {k}", path.display(), k + 1, r[0]);
             }
-            bail!("{} line {}: expected 'frame,pan_deg,tilt_deg', got '{line}'", path.display(), n + 1);
-        };
-        let tilt = match f.get(2) {
-            Some(v) => {
-                v.parse::<f32>().with_context(|| format!("{} line {}: bad tilt '{v}'", path.display(), n + 1))?
-            }
-            None => 0.0,
-        };
-        if frame != out.len() {
-            bail!("{} line {}: frame {frame}, expected {}", path.display(), n + 1, out.len());
-        }
-        if !pan.is_finite() || !tilt.is_finite() {
-            bail!("{} line {}: non-finite angle", path.display(), n + 1);
-        }
-        out.push((pan, tilt));
-    }
-    Ok(out)
+            Ok((r[1] as f32, r[2] as f32))
+        })
+        .collect()
 }

@@ -43,14 +43,6 @@ pub struct StereoArgs {
     pub out: PathBuf,
 }
 
-fn grey(img: &RgbImage) -> Plane<u8> {
-    let (w, h) = img.size();
-    Plane::from_fn(w, h, |x, y| {
-        let c = img.get_f32(x, y);
-        ((0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2]) * 255.0).round().clamp(0.0, 255.0) as u8
-    })
-}
-
 /// Disparity as a heat map (0..max), invalid pixels black.
 fn disparity_image(d: &Plane<f32>, max: f32) -> Plane<[u8; 3]> {
     Plane::from_fn(d.width(), d.height(), |x, y| {
@@ -104,7 +96,7 @@ pub fn run(a: StereoArgs) -> Result<()> {
         uniqueness: a.uniqueness,
         ..BlockMatching::default()
     };
-    let (l, r) = (grey(&li), grey(&ri));
+    let (l, r) = (li.to_luma8(), ri.to_luma8());
     let t = Instant::now();
     let disp = block_match(&l, &r, &p)?;
     let ms = t.elapsed().as_secs_f64() * 1e3;

@@ -55,34 +55,21 @@ pub fn run(a: TriangulateArgs) -> Result<()> {
         bail!("--seed-form works with exactly two cameras");
     }
     let ps: Vec<Matrix3x4<f64>> = a.cameras.iter().map(|c| read_camera(c)).collect::<Result<_>>()?;
-    let text = std::fs::read_to_string(&a.matches).with_context(|| format!("cannot read {}", a.matches.display()))?;
+    let rows = ocellus_io::csv::read_rows(&a.matches, 2 * ps.len(), "a pixel 'u,v' per camera")?;
     let mut out = std::io::BufWriter::new(
         std::fs::File::create(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?,
     );
     writeln!(out, "x,y,z,in_front,rms_px")?;
     let (mut n, mut behind) = (0usize, 0usize);
-    for (line_no, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let v: Vec<Option<f64>> =
-            line.split([',', ';', '\t', ' ']).filter(|s| !s.is_empty()).map(|s| s.parse().ok()).collect();
-        if v.len() < 2 * ps.len() || v[..2 * ps.len()].iter().any(Option::is_none) {
-            if n == 0 && line_no == 0 {
-                continue; // header
-            }
-            bail!("{} line {}: expected {} numbers (u, v per camera)", a.matches.display(), line_no + 1, 2 * ps.len());
-        }
-        let px: Vec<[f64; 2]> =
-            (0..ps.len()).map(|i| [v[2 * i].unwrap_or(f64::NAN), v[2 * i + 1].unwrap_or(f64::NAN)]).collect();
+    for (i, row) in rows.iter().enumerate() {
+        let px: Vec<[f64; 2]> = row.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
         let t = if a.seed_form {
             two_view_seed(&ps[0], px[0], &ps[1], px[1])
         } else {
             let views: Vec<_> = ps.iter().zip(&px).map(|(p, x)| (p, *x)).collect();
             n_view(&views)
         }
-        .with_context(|| format!("{} line {}", a.matches.display(), line_no + 1))?;
+        .with_context(|| format!("{} row {}", a.matches.display(), i + 1))?;
         let x = Vector4::new(t.point.x, t.point.y, t.point.z, 1.0);
         let sq: f64 = ps
             .iter()

@@ -7,12 +7,7 @@ use ocellus_image::Plane;
 use ocellus_testdata::data_file;
 
 fn grey(name: &str) -> Plane<u8> {
-    let img = ocellus_io::read_image(data_file(name)).unwrap();
-    let (w, h) = img.size();
-    Plane::from_fn(w, h, |x, y| {
-        let c = img.get_f32(x, y);
-        ((0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2]) * 255.0).round() as u8
-    })
+    ocellus_io::read_image(data_file(name)).unwrap().to_luma8()
 }
 
 #[test]

@@ -39,6 +39,15 @@ impl RgbImage {
             RgbImage::F32(p) => p.map(|c| c.map(|v| (v.clamp(0.0, 1.0) * 255.0).round() as u8)),
         }
     }
+
+    /// 8-bit luma, BT.601 weights (0.299, 0.587, 0.114), rounded and saturated.
+    pub fn to_luma8(&self) -> Plane<u8> {
+        let (w, h) = self.size();
+        Plane::from_fn(w, h, |x, y| {
+            let [r, g, b] = self.get_f32(x, y);
+            ((0.299 * r + 0.587 * g + 0.114 * b) * 255.0).round().clamp(0.0, 255.0) as u8
+        })
+    }
 }
 
 /// Converts any decoded image to RGB, keeping 16-bit and float precision.

@@ -4,7 +4,7 @@
 //!   error for a missing, unreadable, empty, corrupt or unsupported file.
 //! - [`npy`]: NumPy `.npy` arrays (read f32/f64 in C or Fortran order; write f32, C order).
 //! - [`pfm`]: Portable Float Map, single channel, as Middlebury writes it (rows bottom-up).
-//! - [`points`]: CSV files of 2D points (fixations), in pixels.
+//! - [`csv`]: numeric CSV rows; [`points`]: CSV files of 2D points (fixations), in pixels.
 //! - [`ply`]: coloured point clouds.
 //! - [`video`]: frame sources (image folders, Y4M, any video through the ffmpeg program) and
 //!   [`y4m`] reading and writing.
@@ -20,6 +20,7 @@
 //! assert!(err.to_string().contains("no such file"));
 //! ```
 
+pub mod csv;
 pub mod npy;
 pub mod pfm;
 pub mod ply;

@@ -4,9 +4,10 @@
 //! top-left corner, pixel centres at integer coordinates (so `3,5` is the pixel in column 3,
 //! row 5, and `3.4,5.6` rounds to it). Separators may be commas, semicolons, tabs or spaces;
 //! further columns (a subject id, a duration) are ignored. Blank lines and lines starting with
-//! `#` are skipped, and so is a first line whose first two fields are not numbers (a header).
+//! `#` are skipped, and so is a first line whose first two fields are not numbers (a header);
+//! see [`crate::csv`].
 
-use crate::{read_bytes, IoError, Result};
+use crate::{read_bytes, Result};
 use std::path::Path;
 
 /// Reads a CSV file of points; see the module documentation for the format.
@@ -18,32 +19,8 @@ pub fn read_points(path: impl AsRef<Path>) -> Result<Vec<[f64; 2]>> {
 
 /// Parses CSV text of points; `path` only names the source in errors.
 pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<[f64; 2]>> {
-    let invalid = |reason: String| IoError::Invalid { path: path.into(), reason };
-    let text = std::str::from_utf8(bytes).map_err(|e| invalid(format!("not UTF-8 text: {e}")))?;
-    let mut points = Vec::new();
-    let mut first_content_line = true;
-    for (n, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let mut fields = line.split([',', ';', '\t', ' ']).map(str::trim).filter(|f| !f.is_empty());
-        let (fx, fy) = (fields.next().unwrap_or(""), fields.next().unwrap_or(""));
-        let parsed = (fx.parse::<f64>(), fy.parse::<f64>());
-        let is_header = first_content_line && (parsed.0.is_err() || parsed.1.is_err());
-        first_content_line = false;
-        if is_header {
-            continue;
-        }
-        let (Ok(x), Ok(y)) = parsed else {
-            return Err(invalid(format!("line {}: expected 'x,y' in pixels, got '{line}'", n + 1)));
-        };
-        if !x.is_finite() || !y.is_finite() {
-            return Err(invalid(format!("line {}: non-finite coordinate in '{line}'", n + 1)));
-        }
-        points.push([x, y]);
-    }
-    Ok(points)
+    let rows = crate::csv::parse_rows(bytes, path, 2, "'x,y' in pixels")?;
+    Ok(rows.into_iter().map(|r| [r[0], r[1]]).collect())
 }
 
 /// The pixels (column, row) holding `points`, for an image of `width` x `height`: each point

@@ -151,6 +151,24 @@ pub fn load_samples(items: &[Item], model: &Model) -> Result<Vec<Sample>> {
     Ok(samples)
 }
 
+/// The model's map of every item (in parallel, one engine per worker), without the fixation data.
+pub fn load_maps(items: &[Item], model: &Model) -> Result<Vec<Option<Plane<f32>>>> {
+    let bar = progress(items.len(), "maps");
+    let maps = items
+        .par_iter()
+        .map_init(
+            || None,
+            |engine, item| {
+                let m = model_map(model, item, engine).with_context(|| item.name.clone());
+                bar.inc(1);
+                m
+            },
+        )
+        .collect::<Result<Vec<_>>>()?;
+    bar.finish_and_clear();
+    Ok(maps)
+}
+
 /// The fixations of every image but `i`, rescaled to image `i`'s pixels (pixel centres map to
 /// pixel centres): the negatives of the shuffled AUC.
 pub fn other_fixations(samples: &[Sample], i: usize) -> Vec<(usize, usize)> {

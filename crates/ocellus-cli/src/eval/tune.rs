@@ -8,6 +8,7 @@ use super::data::{self, Item, Sample};
 use super::{density_metrics, mean_se, progress, with_skin, EvalArgs, Model};
 use anyhow::{bail, Result};
 use ocellus_attention::center_prior::CenterPrior;
+use ocellus_image::Plane;
 use rayon::prelude::*;
 use std::ops::Range;
 
@@ -17,14 +18,21 @@ const PRIOR_BLURS: [f32; 4] = [0.04, 0.06, 0.08, 0.1];
 const PRIOR_WEIGHTS: [f32; 4] = [0.5, 0.6, 0.7, 0.8];
 const PRIOR_SIGMAS: [f32; 5] = [0.08, 0.1, 0.12, 0.16, 0.2];
 
-/// `scores[image][combo]` = [CC, SIM, KL] of every combination on every image.
-fn grid_scores(samples: &[Sample], grid: &[CenterPrior], what: &str) -> Result<Vec<Vec<[f64; 3]>>> {
+/// `scores[image][combo]` = [CC, SIM, KL] of every combination on every image, for one
+/// model's `maps` (one per sample; the samples give the density maps).
+fn grid_scores(
+    samples: &[Sample],
+    maps: &[Option<Plane<f32>>],
+    grid: &[CenterPrior],
+    what: &str,
+) -> Result<Vec<Vec<[f64; 3]>>> {
     let bar = progress(samples.len(), what);
     let r = samples
         .par_iter()
-        .map(|s| {
+        .zip(maps)
+        .map(|(s, map)| {
             let Some(d) = &s.density else { bail!("--tune needs fixation density maps (--fixations)") };
-            let r = grid.iter().map(|p| density_metrics(s.map.as_ref(), d, p)).collect::<Result<Vec<_>>>();
+            let r = grid.iter().map(|p| density_metrics(map.as_ref(), d, p)).collect::<Result<Vec<_>>>();
             bar.inc(1);
             r
         })
@@ -63,16 +71,21 @@ pub fn run(a: &EvalArgs, model: &Model, items: &[Item]) -> Result<()> {
         Model::Maps(d) => vec![(0.0, Model::Maps(d.clone()))],
         Model::Centre => bail!("--tune needs a model with maps (ocellus:... or maps:DIR)"),
     };
-    let samples: Vec<Vec<Sample>> = models.iter().map(|(_, m)| data::load_samples(items, m)).collect::<Result<_>>()?;
+    // Density maps are loaded once; each skin weight only adds its saliency maps.
+    let samples = data::load_samples(items, &models[0].1)?;
+    let mut maps: Vec<Vec<Option<Plane<f32>>>> = vec![samples.iter().map(|s| s.map.clone()).collect()];
+    for (_, m) in &models[1..] {
+        maps.push(data::load_maps(items, m)?);
+    }
     println!("{} images, model {}, two-fold cross-validation by CC", items.len(), a.model);
     let map_grid: Vec<CenterPrior> = MAP_BLURS
         .iter()
         .map(|&b| CenterPrior { blur_sigma_frac_width: b, weight: 0.0, center_sigma_frac: 0.25 })
         .collect();
-    let map_scores: Vec<Vec<Vec<[f64; 3]>>> = samples
+    let map_scores: Vec<Vec<Vec<[f64; 3]>>> = maps
         .iter()
         .zip(&models)
-        .map(|(s, (w, _))| grid_scores(s, &map_grid, &format!("map alone, skin {w}")))
+        .map(|(m, (w, _))| grid_scores(&samples, m, &map_grid, &format!("map alone, skin {w}")))
         .collect::<Result<_>>()?;
     // Flatten (skin, blur) into one combination axis per image.
     let n = items.len();
@@ -108,7 +121,7 @@ pub fn run(a: &EvalArgs, model: &Model, items: &[Item]) -> Result<()> {
         map_reported.push(r);
         if prior_scores[skin_idx].is_none() {
             let what = format!("prior grid, skin {}", models[skin_idx].0);
-            prior_scores[skin_idx] = Some(grid_scores(&samples[skin_idx], &prior_grid, &what)?);
+            prior_scores[skin_idx] = Some(grid_scores(&samples, &maps[skin_idx], &prior_grid, &what)?);
         }
         let Some(ps) = &prior_scores[skin_idx] else { continue };
         let c = best(ps, 0..prior_grid.len(), train);
