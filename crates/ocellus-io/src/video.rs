@@ -67,6 +67,8 @@ struct Ffmpeg {
     child: Child,
     stdout: BufReader<ChildStdout>,
     stderr: StderrTail,
+    /// The thread draining stderr; it ends when ffmpeg closes stderr (at exit).
+    drain: Option<std::thread::JoinHandle<()>>,
     width: usize,
     height: usize,
     buf: Vec<u8>,
@@ -145,7 +147,7 @@ impl Ffmpeg {
         };
         let stderr: StderrTail = Arc::default();
         let sink = Arc::clone(&stderr);
-        std::thread::spawn(move || {
+        let drain = std::thread::spawn(move || {
             let mut chunk = [0u8; 4096];
             while let Ok(n) = err.read(&mut chunk) {
                 if n == 0 {
@@ -159,7 +161,15 @@ impl Ffmpeg {
             }
         });
         let buf = vec![0u8; width * height * 3];
-        Ok(Self { child, stdout: BufReader::with_capacity(1 << 20, stdout), stderr, width, height, buf })
+        Ok(Self {
+            child,
+            stdout: BufReader::with_capacity(1 << 20, stdout),
+            stderr,
+            drain: Some(drain),
+            width,
+            height,
+            buf,
+        })
     }
 
     fn stderr_text(&self) -> String {
@@ -188,8 +198,10 @@ impl Ffmpeg {
             return Ok(Some(RgbImage::U8(px)));
         }
         let status = self.child.wait().map_err(|e| IoError::Ffmpeg(e.to_string()))?;
-        // Give the stderr thread a moment to collect the last messages.
-        std::thread::sleep(std::time::Duration::from_millis(20));
+        // ffmpeg has exited: its stderr is closed, so the drain has every message once joined.
+        if let Some(d) = self.drain.take() {
+            let _ = d.join();
+        }
         let msg = self.stderr_text();
         if got > 0 || !status.success() || !msg.is_empty() {
             let why = if msg.is_empty() { format!("ffmpeg exited with {status}") } else { msg };
