@@ -67,7 +67,7 @@ pub fn dlt_linear(points3: &[[f64; 3]], points2: &[[f64; 2]]) -> Result<Matrix3x
 }
 
 /// Similarity that moves points to their centroid and scales them to mean distance `target`.
-fn normalizer<const D: usize>(pts: &[[f64; D]], target: f64) -> Result<(Vec<[f64; D]>, f64, [f64; D])> {
+pub(crate) fn normalizer<const D: usize>(pts: &[[f64; D]], target: f64) -> Result<(Vec<[f64; D]>, f64, [f64; D])> {
     let n = pts.len() as f64;
     let mut c = [0.0; D];
     for p in pts {

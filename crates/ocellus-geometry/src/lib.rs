@@ -5,6 +5,9 @@
 //! - [`distortion`]: radial-tangential lens distortion (k1, k2, k3, p1, p2) and its inverse.
 //! - [`dlt`]: calibration from 3D-2D correspondences: the seed's linear form (p34 = 1) and the
 //!   normalized SVD form (Hartley); reprojection errors; decomposition of P into K, R, t.
+//! - [`homography`]: plane-to-image homographies (normalized DLT).
+//! - [`zhang`]: planar-target calibration: Zhang's closed form, then Levenberg-Marquardt over
+//!   intrinsics, distortion and poses, with parameter standard deviations.
 //! - [`triangulate`]: points from two views (the seed's 4x3 least squares) and from N views (SVD).
 //! - [`stereo`]: parallel stereo with explicit units (disparity, depth, pixel sizes).
 //! - [`block_matching`]: dense disparity by SAD block matching with uniqueness and
@@ -26,8 +29,10 @@ pub mod block_matching;
 pub mod camera;
 pub mod distortion;
 pub mod dlt;
+pub mod homography;
 pub mod stereo;
 pub mod triangulate;
+pub mod zhang;
 
 use thiserror::Error;
 
@@ -37,6 +42,16 @@ pub enum GeometryError {
     /// Too few correspondences.
     #[error("{what} needs at least {need} points, got {got}")]
     TooFewPoints {
+        /// What was attempted.
+        what: &'static str,
+        /// Minimum.
+        need: usize,
+        /// Given.
+        got: usize,
+    },
+    /// Too few views of a calibration target.
+    #[error("{what} needs at least {need} views, got {got}")]
+    TooFewViews {
         /// What was attempted.
         what: &'static str,
         /// Minimum.
