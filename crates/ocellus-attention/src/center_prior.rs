@@ -9,9 +9,8 @@
 //! `center_sigma_frac * max(width, height)`.
 
 use crate::{AttentionError, Result};
-use ocellus_image::filter::{sep_filter, Border, FilterScratch};
 use ocellus_image::resample::{ResampleMethod, Resampler};
-use ocellus_image::{Backend, Plane};
+use ocellus_image::Plane;
 use serde::{Deserialize, Serialize};
 
 /// Blur and centre-prior parameters (fractions of the image size, so they apply to any size).
@@ -76,16 +75,7 @@ pub fn gaussian_blur(map: &Plane<f32>, sigma: f32) -> Result<Plane<f32>> {
     if !(sigma.is_finite() && sigma >= 0.0) {
         return Err(AttentionError::InvalidInput(format!("blur sigma {sigma} must be finite and >= 0")));
     }
-    if sigma < 0.3 {
-        return Ok(map.clone());
-    }
-    let hw = (3.0 * sigma).ceil() as i32;
-    let mut k: Vec<f32> = (-hw..=hw).map(|i| (-(i * i) as f32 / (2.0 * sigma * sigma)).exp()).collect();
-    let s: f32 = k.iter().sum();
-    k.iter_mut().for_each(|v| *v /= s);
-    let mut out = Plane::default();
-    sep_filter(Backend::Auto, map, &mut out, &k, &k, Border::Clamp, &mut FilterScratch::default())?;
-    Ok(out)
+    Ok(ocellus_image::filter::gaussian_blur(map, sigma)?)
 }
 
 /// A Gaussian of peak 1 centred on the image (pixel centres), sigma in pixels.

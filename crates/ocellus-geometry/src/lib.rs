@@ -5,6 +5,7 @@
 //! - [`distortion`]: radial-tangential lens distortion (k1, k2, k3, p1, p2) and its inverse.
 //! - [`dlt`]: calibration from 3D-2D correspondences: the seed's linear form (p34 = 1) and the
 //!   normalized SVD form (Hartley); reprojection errors; decomposition of P into K, R, t.
+//! - [`chessboard`]: chessboard inner-corner detection with sub-pixel refinement.
 //! - [`homography`]: plane-to-image homographies (normalized DLT).
 //! - [`zhang`]: planar-target calibration: Zhang's closed form, then Levenberg-Marquardt over
 //!   intrinsics, distortion and poses, with parameter standard deviations.
@@ -27,6 +28,7 @@
 
 pub mod block_matching;
 pub mod camera;
+pub mod chessboard;
 pub mod distortion;
 pub mod dlt;
 pub mod homography;
@@ -89,6 +91,9 @@ pub enum GeometryError {
         /// Last residual.
         residual: f64,
     },
+    /// Something looked for in an image is not there.
+    #[error("not found: {0}")]
+    NotFound(String),
     /// A parameter is out of range.
     #[error("invalid parameter: {0}")]
     Invalid(String),

@@ -370,6 +370,24 @@ pub fn sep_filter(
     r
 }
 
+/// Separable Gaussian blur (clamped border, kernel cut at 3 sigma, normalized to sum 1);
+/// `sigma` in pixels; sigma < 0.3 returns a copy (the kernel would be a single tap).
+pub fn gaussian_blur(src: &Plane<f32>, sigma: f32) -> Result<Plane<f32>> {
+    if !(sigma.is_finite() && sigma >= 0.0) {
+        return Err(ImageError::InvalidParameter(format!("blur sigma {sigma} must be finite and >= 0")));
+    }
+    if sigma < 0.3 {
+        return Ok(src.clone());
+    }
+    let hw = (3.0 * sigma).ceil() as i32;
+    let mut k: Vec<f32> = (-hw..=hw).map(|i| (-(i * i) as f32 / (2.0 * sigma * sigma)).exp()).collect();
+    let s: f32 = k.iter().sum();
+    k.iter_mut().for_each(|v| *v /= s);
+    let mut out = Plane::default();
+    sep_filter(Backend::Auto, src, &mut out, &k, &k, Border::Clamp, &mut FilterScratch::default())?;
+    Ok(out)
+}
+
 /// Direct 2D correlation (slow reference): `out(x,y) = sum k(i,j) in(x+i-hw, y+j-hh)`.
 /// `k` is row-major `kw` x `kh`, both odd.
 pub fn correlate_2d_direct(src: &Plane<f32>, k: &[f32], kw: usize, kh: usize, border: Border) -> Plane<f32> {

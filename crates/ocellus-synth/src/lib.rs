@@ -2,6 +2,8 @@
 //!
 //! - [`attention_scenes`]: sequences for surprise, context and attention (a static scene with
 //!   sensor noise, an object that appears suddenly, a steady camera pan), with per-frame truth.
+//! - [`chessboard`]: views of a chessboard through a known distorted camera (calibration
+//!   ground truth).
 //! - [`corridor`]: a corridor with textured walls, poster landmarks and a person, rendered by
 //!   a pinhole camera with a pan angle (view-planning experiments).
 //!
@@ -23,6 +25,7 @@
 //! ```
 
 pub mod attention_scenes;
+pub mod chessboard;
 pub mod corridor;
 pub mod texture;
 
