@@ -1,4 +1,5 @@
-//! `ocellus calibrate`: camera calibration from correspondences.
+//! `ocellus calibrate`: camera calibration from 3D-2D correspondences (DLT); the planar forms
+//! are in `calibrate_planar`.
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
@@ -17,6 +18,12 @@ pub struct CalibrateArgs {
 enum What {
     /// The 3x4 projection matrix from 3D-2D correspondences (DLT), decomposed into K, R, t.
     Dlt(DltArgs),
+    /// Zhang calibration with lens distortion from images of a chessboard: detects the inner
+    /// corners (sub-pixel), calibrates, and writes camera.toml, calibration.json (standard
+    /// deviations, per-view errors and poses), per_view_error.png and corner overlays.
+    Chessboard(crate::calibrate_planar::ChessboardArgs),
+    /// Zhang calibration from given correspondences on a planar target (CSV `view,X,Y,u,v`).
+    Planar(crate::calibrate_planar::PlanarArgs),
 }
 
 #[derive(Args, Debug)]
@@ -43,7 +50,14 @@ fn read_correspondences(path: &Path) -> Result<Correspondences> {
 
 /// Runs the subcommand.
 pub fn run(a: CalibrateArgs) -> Result<()> {
-    let What::Dlt(a) = a.what;
+    match a.what {
+        What::Dlt(a) => run_dlt(a),
+        What::Chessboard(a) => crate::calibrate_planar::run_chessboard(a),
+        What::Planar(a) => crate::calibrate_planar::run_planar(a),
+    }
+}
+
+fn run_dlt(a: DltArgs) -> Result<()> {
     let (p3, p2) = read_correspondences(&a.points)?;
     let p = if a.linear { dlt_linear(&p3, &p2)? } else { dlt(&p3, &p2)? };
     let err = reprojection(&p, &p3, &p2);

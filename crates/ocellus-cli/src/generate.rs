@@ -21,6 +21,9 @@ enum What {
     /// Sequences for surprise, context chaos and attention: a still scene with sensor noise, an
     /// object appearing suddenly, or a steady camera pan, over a panorama of the built-in photos.
     Attention(AttentionArgs),
+    /// Views of a chessboard over a real photo, rendered through a known distorted camera, with
+    /// the true camera and corner positions (try `ocellus calibrate chessboard` on them).
+    Chessboard(crate::generate_chessboard::ChessboardArgs),
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -75,7 +78,10 @@ struct Out {
 
 /// Runs the subcommand.
 pub fn run(a: GenerateArgs) -> Result<()> {
-    let What::Attention(a) = a.what;
+    let a = match a.what {
+        What::Attention(a) => a,
+        What::Chessboard(a) => return crate::generate_chessboard::run(a),
+    };
     let scenario = match a.scenario {
         ScenarioArg::Static => Scenario::Static,
         ScenarioArg::Sudden => Scenario::SuddenObject,

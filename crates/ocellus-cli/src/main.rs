@@ -7,12 +7,15 @@ mod bench_attention;
 mod bench_geometry;
 mod bench_planning;
 mod calibrate_cmd;
+mod calibrate_planar;
+mod camera_file;
 mod config_file;
 mod corridor_sim;
 mod demo;
 mod eval;
 mod frames;
 mod generate;
+mod generate_chessboard;
 mod inputs;
 mod overlay;
 mod plan_cmd;
@@ -21,6 +24,7 @@ mod saliency_cmd;
 mod stereo_cmd;
 mod surprise_cmd;
 mod triangulate_cmd;
+mod undistort_cmd;
 mod video_out;
 
 use anyhow::Result;
@@ -57,8 +61,12 @@ enum Command {
     /// Information-based view-direction planning in a simulated corridor (top-down landmarks
     /// vs bottom-up surprise, switched by the context chaos degree).
     Plan(plan_cmd::PlanArgs),
-    /// Camera calibration: `dlt` from 3D-2D correspondences (writes K, R, t, P and errors).
+    /// Camera calibration: `dlt` from 3D-2D correspondences (K, R, t, P and errors);
+    /// `chessboard` from images of a chessboard and `planar` from planar correspondences
+    /// (Zhang with lens distortion; camera.toml, standard deviations, per-view errors).
     Calibrate(calibrate_cmd::CalibrateArgs),
+    /// Remove lens distortion from images with a calibrated camera file (same intrinsics).
+    Undistort(undistort_cmd::UndistortArgs),
     /// 3D points from pixel matches in two or more calibrated cameras (camera JSON files of
     /// `ocellus calibrate dlt`); flags points behind a camera.
     Triangulate(triangulate_cmd::TriangulateArgs),
@@ -92,6 +100,7 @@ fn main() {
         Command::Stereo(a) => stereo_cmd::run(a),
         Command::Calibrate(a) => calibrate_cmd::run(a),
         Command::Triangulate(a) => triangulate_cmd::run(a),
+        Command::Undistort(a) => undistort_cmd::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

@@ -1,0 +1,63 @@
+//! `ocellus undistort`: removes lens distortion from images with a calibrated camera.
+
+use crate::camera_file;
+use crate::inputs::{collect_images, stem};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use ocellus_geometry::distortion::{remap_bilinear, undistort_maps};
+use ocellus_image::Plane;
+use std::path::PathBuf;
+
+/// Arguments of `ocellus undistort`.
+#[derive(Args, Debug)]
+pub struct UndistortArgs {
+    /// Images or folders of images, all of the camera's size.
+    #[arg(required = true)]
+    images: Vec<PathBuf>,
+    /// Camera file (TOML or JSON with `intrinsics` and `distortion`, e.g. from
+    /// `ocellus calibrate chessboard`).
+    #[arg(long)]
+    camera: PathBuf,
+    /// Output folder: NAME.png per input, undistorted with the same intrinsics (pixels
+    /// without a source are black).
+    #[arg(long, default_value = "ocellus-undistorted")]
+    out: PathBuf,
+}
+
+/// Image size and the x, y remap tables built for it.
+type RemapTables = ((usize, usize), Plane<f32>, Plane<f32>);
+
+/// Runs the subcommand.
+pub fn run(a: UndistortArgs) -> Result<()> {
+    let cam = camera_file::read(&a.camera)?;
+    let files = collect_images(&a.images)?;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    // Remap tables for the current image size.
+    let mut maps: Option<RemapTables> = None;
+    for f in &files {
+        let img = ocellus_io::read_image(f).with_context(|| format!("cannot read {}", f.display()))?.to_u8();
+        let size = img.size();
+        if let Some([w, h]) = cam.image_size {
+            if (w, h) != size {
+                bail!("{} is {}x{}, the camera was calibrated at {w}x{h}", f.display(), size.0, size.1);
+            }
+        }
+        if maps.as_ref().map(|m| m.0) != Some(size) {
+            maps = None;
+        }
+        let (_, mx, my) = maps.get_or_insert_with(|| {
+            let (mx, my) = undistort_maps(&cam.intrinsics, &cam.distortion, size.0, size.1);
+            (size, mx, my)
+        });
+        let channels: Vec<Plane<f32>> = (0..3)
+            .map(|c| remap_bilinear(&img.map(|p| p[c] as f32), &*mx, &*my, 0.0))
+            .collect::<std::result::Result<_, _>>()?;
+        let out = image::RgbImage::from_fn(size.0 as u32, size.1 as u32, |x, y| {
+            image::Rgb(std::array::from_fn(|c| channels[c].get(x as usize, y as usize).round().clamp(0.0, 255.0) as u8))
+        });
+        let path = a.out.join(format!("{}.png", stem(f)));
+        ocellus_io::write_png(&path, &out)?;
+    }
+    println!("{} images undistorted into {}", files.len(), a.out.display());
+    Ok(())
+}
