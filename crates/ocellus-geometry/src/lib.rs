@@ -6,6 +6,7 @@
 //! - [`dlt`]: calibration from 3D-2D correspondences: the seed's linear form (p34 = 1) and the
 //!   normalized SVD form (Hartley); reprojection errors; decomposition of P into K, R, t.
 //! - [`chessboard`]: chessboard inner-corner detection with sub-pixel refinement.
+//! - [`sgm`]: dense disparity by semi-global matching on census costs (4 or 8 paths).
 //! - [`homography`]: plane-to-image homographies (normalized DLT).
 //! - [`zhang`]: planar-target calibration: Zhang's closed form, then Levenberg-Marquardt over
 //!   intrinsics, distortion and poses, with parameter standard deviations.
@@ -32,6 +33,7 @@ pub mod chessboard;
 pub mod distortion;
 pub mod dlt;
 pub mod homography;
+pub mod sgm;
 pub mod stereo;
 pub mod triangulate;
 pub mod zhang;

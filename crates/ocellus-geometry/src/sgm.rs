@@ -1,0 +1,580 @@
+//! Dense disparity by semi-global matching (Hirschmüller, "Stereo processing by semiglobal
+//! matching and mutual information", IEEE TPAMI 30(2), 2008), beyond the seed's block matching.
+//!
+//! - **Matching cost:** Hamming distance between census transforms (Zabih & Woodfill 1994) of
+//!   a `census_width` x `census_height` window (at most 63 neighbours, one bit each: darker
+//!   than the centre). Census is invariant to monotonic brightness changes between the two
+//!   cameras, which real pairs have.
+//! - **Aggregation** along 4 (horizontal, vertical) or 8 (plus diagonals) straight paths:
+//!   `L_r(p, d) = C(p, d) + min(L_r(p - r, d), L_r(p - r, d +- 1) + P1, min_k L_r(p - r, k) + P2)
+//!   - min_k L_r(p - r, k)`, summed over paths. Two passes over the image (paths arriving from
+//!   above and the left, then from below and the right), each keeping one previous row.
+//!   Costs are u16 and the inner loop over disparities is written for the compiler to
+//!   vectorize (AVX2 build chosen at run time).
+//! - **Selection:** winner-take-all on the summed cost, a uniqueness test, sub-pixel parabola,
+//!   a left-right check against the right image's winners (from the left winners, as
+//!   OpenCV's SGBM does), and a 3x3 median over valid neighbours. Invalid pixels are NaN.
+//! - [`SgmMatcher`] owns the cost volume and every buffer, for streams of pairs.
+//!
+//! Left pixel (x, y) with disparity d matches right pixel (x - d, y). For `x < d` there is no
+//! right pixel; the right image's first column stands in for the cost (replicated border),
+//! and such a disparity, if it wins, is reported invalid.
+
+use crate::{GeometryError, Result};
+use ocellus_image::simd::Madd;
+use ocellus_image::{dispatch_kernel, Backend, Plane};
+
+/// Paths of the aggregation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SgmPaths {
+    /// Left, right, up, down.
+    Four,
+    /// The four and the diagonals.
+    Eight,
+}
+
+/// Parameters of [`sgm`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sgm {
+    /// Disparities searched: `0..max_disparity` (1..=256).
+    pub max_disparity: usize,
+    /// Census window width, odd, pixels.
+    pub census_width: usize,
+    /// Census window height, odd, pixels (`width * height - 1 <= 63`).
+    pub census_height: usize,
+    /// Penalty of a one-pixel disparity change between neighbours (cost units: census bits).
+    pub p1: u16,
+    /// Penalty of a larger disparity change.
+    pub p2: u16,
+    /// Which paths.
+    pub paths: SgmPaths,
+    /// Uniqueness margin: the best must beat every non-adjacent disparity by this fraction.
+    pub uniqueness: f32,
+    /// Largest left-right disagreement kept, pixels (negative disables the check).
+    pub lr_max_diff: f32,
+    /// 3x3 median of the valid disparities afterwards.
+    pub median: bool,
+}
+
+impl Default for Sgm {
+    /// 64 disparities, census 9x7, P1 10, P2 120, 8 paths, uniqueness 0.05, left-right 1 px,
+    /// median on.
+    fn default() -> Self {
+        Self {
+            max_disparity: 64,
+            census_width: 9,
+            census_height: 7,
+            p1: 10,
+            p2: 120,
+            paths: SgmPaths::Eight,
+            uniqueness: 0.05,
+            lr_max_diff: 1.0,
+            median: true,
+        }
+    }
+}
+
+impl Sgm {
+    fn check(&self, left: &Plane<u8>, right: &Plane<u8>) -> Result<()> {
+        if left.size() != right.size() {
+            return Err(GeometryError::Invalid(format!(
+                "stereo images differ in size: {}x{} and {}x{}",
+                left.width(),
+                left.height(),
+                right.width(),
+                right.height()
+            )));
+        }
+        if !(1..=256).contains(&self.max_disparity) {
+            return Err(GeometryError::Invalid(format!("max_disparity {} must be 1..=256", self.max_disparity)));
+        }
+        let (cw, ch) = (self.census_width, self.census_height);
+        if cw % 2 == 0 || ch % 2 == 0 || cw * ch - 1 > 63 || cw * ch < 9 {
+            return Err(GeometryError::Invalid(format!(
+                "census window {cw}x{ch}: both sides odd, at least 3x3, at most 63 neighbours"
+            )));
+        }
+        if self.p1 == 0 || self.p2 < self.p1 || self.p2 > 1000 {
+            return Err(GeometryError::Invalid(format!("penalties P1 {} and P2 {}: need 0 < P1 <= P2 <= 1000", self.p1, self.p2)));
+        }
+        let (w, h) = left.size();
+        if w < cw || h < ch || w < 2 {
+            return Err(GeometryError::Invalid(format!("images {w}x{h} are smaller than the census window {cw}x{ch}")));
+        }
+        Ok(())
+    }
+}
+
+/// Census transform: bit k set when neighbour k is darker than the centre (borders
+/// replicated).
+pub fn census(img: &Plane<u8>, width: usize, height: usize) -> Plane<u64> {
+    let mut out = Plane::<u64>::new(img.width(), img.height());
+    census_kernel(Backend::Auto, img, width, height, &mut out);
+    out
+}
+
+#[inline(always)]
+fn census_generic<M: Madd>(img: &Plane<u8>, width: usize, height: usize, out: &mut Plane<u64>) {
+    let (w, h) = img.size();
+    let (hw, hh) = ((width / 2) as isize, (height / 2) as isize);
+    out.resize(w, h);
+    let mut padded = vec![0u8; w + 2 * hw as usize];
+    for y in 0..h {
+        let centre = img.row(y);
+        let row_out = out.row_mut(y);
+        row_out.fill(0);
+        let mut bit = 0u32;
+        for dy in -hh..=hh {
+            let src = img.row((y as isize + dy).clamp(0, h as isize - 1) as usize);
+            padded[hw as usize..hw as usize + w].copy_from_slice(src);
+            let (first, last) = (src[0], src[w - 1]);
+            padded[..hw as usize].fill(first);
+            padded[hw as usize + w..].fill(last);
+            for dx in -hw..=hw {
+                if dx == 0 && dy == 0 {
+                    continue;
+                }
+                let shifted = &padded[(hw + dx) as usize..(hw + dx) as usize + w];
+                for ((o, &s), &c) in row_out.iter_mut().zip(shifted).zip(centre) {
+                    *o |= u64::from(s < c) << bit;
+                }
+                bit += 1;
+            }
+        }
+    }
+}
+
+dispatch_kernel!(fn census_kernel => census_generic(img: &Plane<u8>, width: usize, height: usize, out: &mut Plane<u64>));
+
+/// One path step at one pixel: `cur[d + 1]` from `prev[d..d + 3]` (padded by one on each
+/// side with a large value) and the cost; returns the minimum of `cur`.
+#[inline(always)]
+fn path_step(cost: &[u8], prev: &[u16], prev_min: u16, cur: &mut [u16], p1: u16, p2: u16) -> u16 {
+    let lim = prev_min.saturating_add(p2);
+    let mut m = u16::MAX;
+    let n = cost.len();
+    let (prev, cur) = (&prev[..n + 2], &mut cur[..n + 2]);
+    for d in 0..n {
+        let near = prev[d].min(prev[d + 2]).saturating_add(p1);
+        let v = prev[d + 1].min(near).min(lim);
+        let val = cost[d] as u16 + v - prev_min;
+        cur[d + 1] = val;
+        m = m.min(val);
+    }
+    m
+}
+
+/// Large value for the padding of path buffers (never chosen; adding P1 cannot overflow).
+const PAD: u16 = 0x7000;
+
+/// Buffers of one pass: per path, the previous and current row of L (padded), and minima.
+struct PassBuffers {
+    dp: usize,
+    /// Per vertical-ish path (up to 3): previous row, current row, their minima.
+    prev: Vec<Vec<u16>>,
+    cur: Vec<Vec<u16>>,
+    prev_min: Vec<Vec<u16>>,
+    cur_min: Vec<Vec<u16>>,
+    /// Horizontal path: previous and current pixel.
+    h_prev: Vec<u16>,
+    h_cur: Vec<u16>,
+    zeros: Vec<u16>,
+}
+
+impl PassBuffers {
+    fn new(w: usize, d: usize, vertical_paths: usize) -> Self {
+        let dp = d + 2;
+        let padded = |len: usize| {
+            let mut v = vec![0u16; len * dp];
+            for k in 0..len {
+                v[k * dp] = PAD;
+                v[k * dp + dp - 1] = PAD;
+            }
+            v
+        };
+        Self {
+            dp,
+            prev: (0..vertical_paths).map(|_| padded(w)).collect(),
+            cur: (0..vertical_paths).map(|_| padded(w)).collect(),
+            prev_min: vec![vec![0; w]; vertical_paths],
+            cur_min: vec![vec![0; w]; vertical_paths],
+            h_prev: padded(1),
+            h_cur: padded(1),
+            zeros: padded(1),
+        }
+    }
+}
+
+/// One aggregation pass: rows in `forward` order (top to bottom, pixels left to right) or
+/// reversed; adds every path's L into `sum` (or stores it when `first`).
+#[inline(always)]
+fn pass_generic<M: Madd>(
+    cost: &[u8],
+    sum: &mut [u16],
+    w: usize,
+    h: usize,
+    d: usize,
+    p1: u16,
+    p2: u16,
+    diagonals: bool,
+    forward: bool,
+) {
+    let vertical_paths = if diagonals { 3 } else { 1 };
+    let mut b = PassBuffers::new(w, d, vertical_paths);
+    let dp = b.dp;
+    // Offsets (in x, iteration order) of the previous row's pixel for each vertical path:
+    // straight, then the two diagonals.
+    let offsets: [isize; 3] = [0, -1, 1];
+    for step_y in 0..h {
+        let y = if forward { step_y } else { h - 1 - step_y };
+        let mut h_min = 0u16;
+        b.h_prev.copy_from_slice(&b.zeros);
+        for step_x in 0..w {
+            let x = if forward { step_x } else { w - 1 - step_x };
+            let c = &cost[(y * w + x) * d..(y * w + x + 1) * d];
+            let s = &mut sum[(y * w + x) * d..(y * w + x + 1) * d];
+            // Horizontal path.
+            let m = if step_x == 0 {
+                path_step(c, &b.zeros, 0, &mut b.h_cur, p1, p2)
+            } else {
+                path_step(c, &b.h_prev, h_min, &mut b.h_cur, p1, p2)
+            };
+            h_min = m;
+            std::mem::swap(&mut b.h_prev, &mut b.h_cur);
+            let hp = &b.h_prev[1..d + 1];
+            if forward {
+                s.copy_from_slice(hp);
+            } else {
+                s.iter_mut().zip(hp).for_each(|(a, v)| *a = a.saturating_add(*v));
+            }
+            for (k, &off) in offsets.iter().take(vertical_paths).enumerate() {
+                let px = step_x as isize + off;
+                let from = (step_y > 0 && px >= 0 && (px as usize) < w).then_some(px as usize);
+                let cur = &mut b.cur[k][step_x * dp..(step_x + 1) * dp];
+                let m = match from {
+                    Some(px) => path_step(c, &b.prev[k][px * dp..(px + 1) * dp], b.prev_min[k][px], cur, p1, p2),
+                    None => path_step(c, &b.zeros, 0, cur, p1, p2),
+                };
+                b.cur_min[k][step_x] = m;
+                s.iter_mut().zip(&cur[1..d + 1]).for_each(|(a, v)| *a = a.saturating_add(*v));
+            }
+        }
+        for k in 0..vertical_paths {
+            std::mem::swap(&mut b.prev[k], &mut b.cur[k]);
+            std::mem::swap(&mut b.prev_min[k], &mut b.cur_min[k]);
+        }
+    }
+}
+
+dispatch_kernel!(fn pass_kernel => pass_generic(
+    cost: &[u8], sum: &mut [u16], w: usize, h: usize, d: usize, p1: u16, p2: u16, diagonals: bool, forward: bool
+));
+
+#[inline(always)]
+fn costs_generic(cl: &Plane<u64>, cr: &Plane<u64>, cost: &mut [u8], d: usize) {
+    let (w, h) = cl.size();
+    for y in 0..h {
+        let (l, r) = (cl.row(y), cr.row(y));
+        for x in 0..w {
+            let c = &mut cost[(y * w + x) * d..(y * w + x + 1) * d];
+            let lx = l[x];
+            let valid = d.min(x + 1);
+            for (k, v) in c[..valid].iter_mut().enumerate() {
+                *v = (lx ^ r[x - k]).count_ones() as u8;
+            }
+            // Past the right image's border, its first column repeats (a neutral cost: a
+            // fixed maximum would leak along the paths into flat regions).
+            let edge = (lx ^ r[0]).count_ones() as u8;
+            c[valid..].fill(edge);
+        }
+    }
+}
+
+/// Census Hamming costs; the fast build uses the POPCNT instruction.
+fn costs_kernel(backend: Backend, cl: &Plane<u64>, cr: &Plane<u64>, cost: &mut [u8], d: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx2,popcnt")]
+        unsafe fn fast(cl: &Plane<u64>, cr: &Plane<u64>, cost: &mut [u8], d: usize) {
+            costs_generic(cl, cr, cost, d)
+        }
+        if backend.resolve() == Backend::Avx2 && is_x86_feature_detected!("popcnt") {
+            // SAFETY: the CPU has AVX2 (resolve) and POPCNT (checked).
+            return unsafe { fast(cl, cr, cost, d) };
+        }
+    }
+    let _ = backend;
+    costs_generic(cl, cr, cost, d)
+}
+
+/// SGM for one image size, owning every buffer: after the first pair, computing a
+/// disparity map allocates nothing.
+#[derive(Clone, Debug)]
+pub struct SgmMatcher {
+    params: Sgm,
+    size: (usize, usize),
+    census_left: Plane<u64>,
+    census_right: Plane<u64>,
+    cost: Vec<u8>,
+    sum: Vec<u16>,
+    raw: Plane<f32>,
+    out: Plane<f32>,
+}
+
+impl SgmMatcher {
+    /// A matcher for `width` x `height` pairs; errors for invalid parameters or sizes.
+    pub fn new(params: Sgm, width: usize, height: usize) -> Result<Self> {
+        let probe = Plane::<u8>::new(width, height);
+        params.check(&probe, &probe)?;
+        let n = width
+            .checked_mul(height)
+            .and_then(|v| v.checked_mul(params.max_disparity))
+            .filter(|&v| v <= 1 << 32)
+            .ok_or_else(|| GeometryError::Invalid(format!("cost volume {width}x{height}x{} is too large", params.max_disparity)))?;
+        Ok(Self {
+            params,
+            size: (width, height),
+            census_left: Plane::new(width, height),
+            census_right: Plane::new(width, height),
+            cost: vec![0; n],
+            sum: vec![0; n],
+            raw: Plane::new(width, height),
+            out: Plane::new(width, height),
+        })
+    }
+
+    /// Disparity of the left image: pixels, NaN where invalid.
+    pub fn compute(&mut self, left: &Plane<u8>, right: &Plane<u8>) -> Result<&Plane<f32>> {
+        let p = self.params;
+        p.check(left, right)?;
+        if left.size() != self.size {
+            return Err(GeometryError::Invalid(format!(
+                "images are {}x{}, the matcher was made for {}x{}",
+                left.width(),
+                left.height(),
+                self.size.0,
+                self.size.1
+            )));
+        }
+        let (w, h) = self.size;
+        let d = p.max_disparity;
+        census_kernel(Backend::Auto, left, p.census_width, p.census_height, &mut self.census_left);
+        census_kernel(Backend::Auto, right, p.census_width, p.census_height, &mut self.census_right);
+        costs_kernel(Backend::Auto, &self.census_left, &self.census_right, &mut self.cost, d);
+        let diagonals = p.paths == SgmPaths::Eight;
+        pass_kernel(Backend::Auto, &self.cost, &mut self.sum, w, h, d, p.p1, p.p2, diagonals, true);
+        pass_kernel(Backend::Auto, &self.cost, &mut self.sum, w, h, d, p.p1, p.p2, diagonals, false);
+        select_kernel(Backend::Auto, &self.sum, &mut self.raw, &p);
+        if p.median {
+            median3(&self.raw, &mut self.out);
+            Ok(&self.out)
+        } else {
+            Ok(&self.raw)
+        }
+    }
+}
+
+/// Disparity of the left image by SGM (allocating; see [`SgmMatcher`] for streams).
+pub fn sgm(left: &Plane<u8>, right: &Plane<u8>, p: &Sgm) -> Result<Plane<f32>> {
+    p.check(left, right)?;
+    let mut m = SgmMatcher::new(*p, left.width(), left.height())?;
+    Ok(m.compute(left, right)?.clone())
+}
+
+/// Winner-take-all with uniqueness, sub-pixel and the left-right check. The right image's
+/// winners are taken, as in OpenCV's SGBM, from the left pixels' winners: right pixel
+/// x - d keeps the disparity d of the cheapest left pixel that chose it.
+#[inline(always)]
+fn select_generic<M: Madd>(sum: &[u16], out: &mut Plane<f32>, p: &Sgm) {
+    let (w, h) = out.size();
+    let d = p.max_disparity;
+    let mut best_of = vec![0usize; w];
+    let mut right_best = vec![usize::MAX; w];
+    let mut right_cost = vec![u16::MAX; w];
+    for y in 0..h {
+        right_cost.fill(u16::MAX);
+        right_best.fill(usize::MAX);
+        let row = out.row_mut(y);
+        for x in 0..w {
+            let s = &sum[(y * w + x) * d..(y * w + x + 1) * d];
+            let bc = s.iter().copied().min().unwrap_or(0);
+            let best = s.iter().position(|&v| v == bc).unwrap_or(0);
+            let (lo, hi) = (best.saturating_sub(1), (best + 2).min(d));
+            let other = s[..lo].iter().chain(&s[hi..]).copied().min().unwrap_or(u16::MAX);
+            // Uniqueness needs at least three possible disparities (x >= 2).
+            let ambiguous = (other as f32) * (1.0 - p.uniqueness) <= bc as f32;
+            best_of[x] = best;
+            if ambiguous || best > x || x < 2 {
+                row[x] = f32::NAN;
+                continue;
+            }
+            let mut disp = best as f32;
+            if best > 0 && best + 1 < d {
+                let (a, b, c) = (s[best - 1] as f32, bc as f32, s[best + 1] as f32);
+                let den = a - 2.0 * b + c;
+                if den > 0.0 {
+                    disp += 0.5 * (a - c) / den;
+                }
+            }
+            row[x] = disp;
+            let xr = x - best;
+            if bc < right_cost[xr] {
+                right_cost[xr] = bc;
+                right_best[xr] = best;
+            }
+        }
+        if p.lr_max_diff >= 0.0 {
+            for x in 0..w {
+                if row[x].is_finite() {
+                    let rb = right_best[x - best_of[x]];
+                    if rb == usize::MAX || (rb as f32 - best_of[x] as f32).abs() > p.lr_max_diff {
+                        row[x] = f32::NAN;
+                    }
+                }
+            }
+        }
+    }
+}
+
+dispatch_kernel!(fn select_kernel => select_generic(sum: &[u16], out: &mut Plane<f32>, p: &Sgm));
+
+/// 3x3 median over the valid (finite) values; invalid pixels stay invalid.
+fn median3(src: &Plane<f32>, dst: &mut Plane<f32>) {
+    let (w, h) = src.size();
+    dst.resize(w, h);
+    let mut buf = [0f32; 9];
+    for y in 0..h {
+        let rows = [src.row(y.saturating_sub(1)), src.row(y), src.row((y + 1).min(h - 1))];
+        let out = dst.row_mut(y);
+        for x in 0..w {
+            let v = rows[1][x];
+            if !v.is_finite() {
+                out[x] = v;
+                continue;
+            }
+            let mut n = 0;
+            let (x0, x1) = (x.saturating_sub(1), (x + 1).min(w - 1));
+            for (r, row) in rows.iter().enumerate() {
+                // Replicated border rows would count twice; skip them.
+                if (r == 0 && y == 0) || (r == 2 && y + 1 == h) {
+                    continue;
+                }
+                for &q in &row[x0..=x1] {
+                    if q.is_finite() {
+                        buf[n] = q;
+                        n += 1;
+                    }
+                }
+            }
+            let vals = &mut buf[..n];
+            let k = n / 2;
+            vals.select_nth_unstable_by(k, f32::total_cmp);
+            out[x] = vals[k];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::block_matching::bad_pixels;
+    use ocellus_image::rng::SplitMix64;
+
+    #[test]
+    fn census_bits_match_a_direct_count() {
+        let mut rng = SplitMix64::new(2);
+        let img = Plane::from_fn(23, 17, |_, _| (rng.next_u64() & 255) as u8);
+        let c = census(&img, 5, 3);
+        for (x, y) in [(0usize, 0usize), (11, 8), (22, 16), (3, 1)] {
+            let mut want = 0u64;
+            let mut bit = 0;
+            for dy in -1isize..=1 {
+                for dx in -2isize..=2 {
+                    if dx == 0 && dy == 0 {
+                        continue;
+                    }
+                    let xx = (x as isize + dx).clamp(0, 22) as usize;
+                    let yy = (y as isize + dy).clamp(0, 16) as usize;
+                    want |= u64::from(img.get(xx, yy) < img.get(x, y)) << bit;
+                    bit += 1;
+                }
+            }
+            assert_eq!(c.get(x, y), want, "({x}, {y})");
+        }
+    }
+
+    #[test]
+    fn path_step_matches_the_recurrence() {
+        let cost = [5u8, 0, 9, 3];
+        let mut prev = vec![PAD, 4, 20, 1, 30, PAD];
+        prev[0] = PAD;
+        let mut cur = vec![0u16; 6];
+        let m = path_step(&cost, &prev, 1, &mut cur, 2, 10);
+        // d = 0: min(4, min(PAD, 20) + 2, 1 + 10) = 4 -> 5 + 4 - 1 = 8;
+        // d = 1: min(20, min(4, 1) + 2, 11) = 3 -> 0 + 3 - 1 = 2;
+        // d = 2: min(1, min(20, 30) + 2, 11) = 1 -> 9; d = 3: min(30, 1 + 2, 11) = 3 -> 5.
+        assert_eq!(&cur[1..5], &[8, 2, 9, 5]);
+        assert_eq!(m, 2);
+    }
+
+    #[test]
+    fn random_dot_pair_with_known_shift() {
+        let mut rng = SplitMix64::new(5);
+        let tex: Vec<u8> = (0..200 * 120).map(|_| (rng.next_u64() & 255) as u8).collect();
+        let left = Plane::from_fn(160, 100, |x, y| tex[y * 200 + x + 20]);
+        let right = Plane::from_fn(160, 100, |x, y| {
+            let near = (60 - 12..100 - 12).contains(&x) && (30..70).contains(&y);
+            let d = if near { 12 } else { 7 };
+            tex[y * 200 + (x + d).min(199) + 20]
+        });
+        let truth = Plane::from_fn(160, 100, |x, y| {
+            if x < 20 {
+                f32::INFINITY
+            } else if (60..100).contains(&x) && (30..70).contains(&y) {
+                12.0f32
+            } else {
+                7.0
+            }
+        });
+        for paths in [SgmPaths::Four, SgmPaths::Eight] {
+            let est = sgm(&left, &right, &Sgm { max_disparity: 20, paths, ..Default::default() }).unwrap();
+            let (bad, density) = bad_pixels(&est, &truth, 0.5).unwrap();
+            assert!(bad < 0.06 && density > 0.94, "{paths:?}: bad {bad}, density {density}");
+            for (x, y, want) in [(30usize, 50usize, 7.0f32), (80, 50, 12.0), (130, 15, 7.0)] {
+                assert!((est.get(x, y) - want).abs() < 0.1, "({x}, {y}): {}", est.get(x, y));
+            }
+        }
+    }
+
+    #[test]
+    fn scalar_and_simd_builds_agree() {
+        let mut rng = SplitMix64::new(8);
+        let a = Plane::from_fn(64, 40, |_, _| (rng.next_u64() & 255) as u8);
+        let b = Plane::from_fn(64, 40, |x, y| a.get((x + 3).min(63), y));
+        let p = Sgm { max_disparity: 16, ..Default::default() };
+        let (cl, cr) = (census(&a, 9, 7), census(&b, 9, 7));
+        let mut sums = Vec::new();
+        for backend in Backend::available() {
+            let mut cost = vec![0u8; 64 * 40 * 16];
+            costs_kernel(backend, &cl, &cr, &mut cost, 16);
+            let mut sum = vec![0u16; 64 * 40 * 16];
+            pass_kernel(backend, &cost, &mut sum, 64, 40, 16, p.p1, p.p2, true, true);
+            pass_kernel(backend, &cost, &mut sum, 64, 40, 16, p.p1, p.p2, true, false);
+            sums.push(sum);
+        }
+        assert!(sums.windows(2).all(|s| s[0] == s[1]));
+    }
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        let a = Plane::new(20, 20);
+        assert!(sgm(&a, &Plane::new(21, 20), &Sgm::default()).is_err());
+        assert!(sgm(&a, &a, &Sgm { census_width: 8, ..Default::default() }).is_err());
+        assert!(sgm(&a, &a, &Sgm { census_width: 11, census_height: 7, ..Default::default() }).is_err());
+        assert!(sgm(&a, &a, &Sgm { p1: 20, p2: 10, ..Default::default() }).is_err());
+        assert!(sgm(&Plane::new(4, 4), &Plane::new(4, 4), &Sgm::default()).is_err());
+        // A flat pair is ambiguous everywhere: all invalid, no panic.
+        let flat = sgm(&a, &a, &Sgm { max_disparity: 8, ..Default::default() }).unwrap();
+        assert!(flat.to_vec().iter().all(|v| v.is_nan()));
+    }
+}
