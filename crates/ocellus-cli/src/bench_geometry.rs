@@ -1,4 +1,5 @@
-//! `ocellus bench geometry`: DLT calibration, triangulation and block matching, one thread.
+//! `ocellus bench geometry`: DLT and Zhang calibration, triangulation, block matching and
+//! semi-global matching, one thread.
 
 use crate::bench::median;
 use anyhow::Result;
@@ -6,6 +7,9 @@ use nalgebra::{Rotation3, Vector3};
 use ocellus_geometry::block_matching::{block_match, BlockMatching};
 use ocellus_geometry::camera::{Intrinsics, PinholeCamera};
 use ocellus_geometry::dlt::dlt;
+use ocellus_geometry::distortion::Distortion;
+use ocellus_geometry::sgm::{Sgm, SgmMatcher, SgmPaths};
+use ocellus_geometry::zhang::{calibrate, project_view, PlanarView, Pose, ZhangOptions};
 use ocellus_geometry::triangulate::{n_view, two_view_seed};
 use ocellus_image::rng::SplitMix64;
 use ocellus_image::Plane;
@@ -70,11 +74,29 @@ pub fn run(json_out: bool, reps: usize) -> Result<()> {
             ms(t)
         })
         .collect();
+    // SGM, steady state (the matcher's buffers reused), on the same pair.
+    let mut t_sgm = Vec::new();
+    for paths in [SgmPaths::Eight, SgmPaths::Four] {
+        let mut m = SgmMatcher::new(Sgm { paths, ..Sgm::default() }, w, h)?;
+        m.compute(&left, &right)?;
+        let mut t: Vec<f64> = (0..reps.clamp(3, 10))
+            .map(|_| {
+                let t = Instant::now();
+                let _ = m.compute(&left, &right);
+                ms(t)
+            })
+            .collect();
+        t_sgm.push(median(&mut t));
+    }
+    let mut t_zhang = zhang_times(reps, &mut rng);
     let v = json!({
         "ms_dlt_100_points": median(&mut t_dlt),
         "ms_triangulate_100k_two_view_seed": median(&mut t_seed),
         "ms_triangulate_100k_two_view_svd": median(&mut t_nview),
         "ms_block_matching_741x500_64disp": median(&mut t_bm),
+        "ms_sgm_8_paths_741x500_64disp": t_sgm[0],
+        "ms_sgm_4_paths_741x500_64disp": t_sgm[1],
+        "ms_zhang_10_views_9x6": median(&mut t_zhang),
     });
     if json_out {
         println!("{v}");
@@ -85,4 +107,30 @@ pub fn run(json_out: bool, reps: usize) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Times Zhang calibration (closed form + Levenberg-Marquardt with k1, k2, p1, p2, k3) on 10
+/// views of a 9x6 board with 0.5 px noise.
+fn zhang_times(reps: usize, rng: &mut SplitMix64) -> Vec<f64> {
+    let k = Intrinsics { fx: 812.0, fy: 806.0, cx: 318.0, cy: 243.0, skew: 0.0 };
+    let d = Distortion { k1: -0.25, k2: 0.08, k3: 0.0, p1: 0.001, p2: -0.0008 };
+    let object: Vec<[f64; 2]> = (0..6).flat_map(|r| (0..9).map(move |c| [c as f64 * 25.0, r as f64 * 25.0])).collect();
+    let mut views = Vec::new();
+    while views.len() < 10 {
+        let r = Rotation3::from_euler_angles((rng.unit() - 0.5) * 1.0, (rng.unit() - 0.5) * 1.0, (rng.unit() - 0.5) * 0.6);
+        let t = Vector3::new((rng.unit() - 0.5) * 80.0, (rng.unit() - 0.5) * 60.0, 350.0 + 200.0 * rng.unit())
+            - r * Vector3::new(100.0, 62.5, 0.0);
+        let Some(img) = project_view(&k, &d, &Pose { r: *r.matrix(), t }, &object) else { continue };
+        if img.iter().all(|p| p[0] >= 0.0 && p[1] >= 0.0 && p[0] <= 639.0 && p[1] <= 479.0) {
+            let image = img.iter().map(|p| [p[0] + 0.5 * rng.normal(), p[1] + 0.5 * rng.normal()]).collect();
+            views.push(PlanarView { object: object.clone(), image });
+        }
+    }
+    (0..reps.max(20))
+        .map(|_| {
+            let t = Instant::now();
+            let _ = calibrate(&views, &ZhangOptions::default());
+            ms(t)
+        })
+        .collect()
 }

@@ -319,6 +319,22 @@ pub struct SgmMatcher {
     sum: Vec<u16>,
     raw: Plane<f32>,
     out: Plane<f32>,
+    timings: SgmTimings,
+}
+
+/// Wall time of each stage of the last [`SgmMatcher::compute`], milliseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SgmTimings {
+    /// Census transforms of both images.
+    pub census_ms: f64,
+    /// Hamming cost volume.
+    pub cost_ms: f64,
+    /// Path aggregation (both passes).
+    pub aggregation_ms: f64,
+    /// Winner selection, uniqueness, sub-pixel, left-right check.
+    pub selection_ms: f64,
+    /// Median filter (0 when off).
+    pub median_ms: f64,
 }
 
 impl SgmMatcher {
@@ -340,7 +356,13 @@ impl SgmMatcher {
             sum: vec![0; n],
             raw: Plane::new(width, height),
             out: Plane::new(width, height),
+            timings: SgmTimings::default(),
         })
+    }
+
+    /// Stage times of the last computation.
+    pub fn timings(&self) -> SgmTimings {
+        self.timings
     }
 
     /// Disparity of the left image: pixels, NaN where invalid.
@@ -358,15 +380,27 @@ impl SgmMatcher {
         }
         let (w, h) = self.size;
         let d = p.max_disparity;
+        let ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
+        let t = std::time::Instant::now();
         census_kernel(Backend::Auto, left, p.census_width, p.census_height, &mut self.census_left);
         census_kernel(Backend::Auto, right, p.census_width, p.census_height, &mut self.census_right);
+        self.timings.census_ms = ms(t);
+        let t = std::time::Instant::now();
         costs_kernel(Backend::Auto, &self.census_left, &self.census_right, &mut self.cost, d);
+        self.timings.cost_ms = ms(t);
+        let t = std::time::Instant::now();
         let diagonals = p.paths == SgmPaths::Eight;
         pass_kernel(Backend::Auto, &self.cost, &mut self.sum, w, h, d, p.p1, p.p2, diagonals, true);
         pass_kernel(Backend::Auto, &self.cost, &mut self.sum, w, h, d, p.p1, p.p2, diagonals, false);
+        self.timings.aggregation_ms = ms(t);
+        let t = std::time::Instant::now();
         select_kernel(Backend::Auto, &self.sum, &mut self.raw, &p);
+        self.timings.selection_ms = ms(t);
+        let t = std::time::Instant::now();
+        self.timings.median_ms = 0.0;
         if p.median {
             median3(&self.raw, &mut self.out);
+            self.timings.median_ms = ms(t);
             Ok(&self.out)
         } else {
             Ok(&self.raw)

@@ -39,14 +39,14 @@ fn motorcycle_sgm_bad2_and_density() {
     use ocellus_geometry::sgm::{sgm, Sgm, SgmPaths};
     let (l, r) = (grey("motorcycle_left.png"), grey("motorcycle_right.png"));
     let truth = ocellus_io::pfm::read(data_file("motorcycle_disp.pfm")).unwrap();
-    for paths in [SgmPaths::Eight, SgmPaths::Four] {
-        let p = Sgm { paths, ..Sgm::default() };
+    for (paths, median) in [(SgmPaths::Eight, true), (SgmPaths::Four, true), (SgmPaths::Eight, false)] {
+        let p = Sgm { paths, median, ..Sgm::default() };
         let t = std::time::Instant::now();
         let est = sgm(&l, &r, &p).unwrap();
         let ms = t.elapsed().as_secs_f64() * 1e3;
         let (bad, density) = bad_pixels(&est, &truth, 2.0).unwrap();
         println!(
-            "motorcycle SGM {paths:?} paths: bad-2.0 {:.2} %, density {:.1} %, {ms:.1} ms (test build)",
+            "motorcycle SGM {paths:?} paths, median {median}: bad-2.0 {:.2} %, density {:.1} %, {ms:.1} ms (test build)",
             bad * 100.0,
             density * 100.0
         );
