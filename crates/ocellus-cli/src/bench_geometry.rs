@@ -6,11 +6,11 @@ use anyhow::Result;
 use nalgebra::{Rotation3, Vector3};
 use ocellus_geometry::block_matching::{block_match, BlockMatching};
 use ocellus_geometry::camera::{Intrinsics, PinholeCamera};
-use ocellus_geometry::dlt::dlt;
 use ocellus_geometry::distortion::Distortion;
+use ocellus_geometry::dlt::dlt;
 use ocellus_geometry::sgm::{Sgm, SgmMatcher, SgmPaths};
-use ocellus_geometry::zhang::{calibrate, project_view, PlanarView, Pose, ZhangOptions};
 use ocellus_geometry::triangulate::{n_view, two_view_seed};
+use ocellus_geometry::zhang::{calibrate, project_view, PlanarView, Pose, ZhangOptions};
 use ocellus_image::rng::SplitMix64;
 use ocellus_image::Plane;
 use serde_json::json;
@@ -117,7 +117,8 @@ fn zhang_times(reps: usize, rng: &mut SplitMix64) -> Vec<f64> {
     let object: Vec<[f64; 2]> = (0..6).flat_map(|r| (0..9).map(move |c| [c as f64 * 25.0, r as f64 * 25.0])).collect();
     let mut views = Vec::new();
     while views.len() < 10 {
-        let r = Rotation3::from_euler_angles((rng.unit() - 0.5) * 1.0, (rng.unit() - 0.5) * 1.0, (rng.unit() - 0.5) * 0.6);
+        let r =
+            Rotation3::from_euler_angles((rng.unit() - 0.5) * 1.0, (rng.unit() - 0.5) * 1.0, (rng.unit() - 0.5) * 0.6);
         let t = Vector3::new((rng.unit() - 0.5) * 80.0, (rng.unit() - 0.5) * 60.0, 350.0 + 200.0 * rng.unit())
             - r * Vector3::new(100.0, 62.5, 0.0);
         let Some(img) = project_view(&k, &d, &Pose { r: *r.matrix(), t }, &object) else { continue };

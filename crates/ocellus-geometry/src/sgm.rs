@@ -95,7 +95,10 @@ impl Sgm {
             )));
         }
         if self.p1 == 0 || self.p2 < self.p1 || self.p2 > 1000 {
-            return Err(GeometryError::Invalid(format!("penalties P1 {} and P2 {}: need 0 < P1 <= P2 <= 1000", self.p1, self.p2)));
+            return Err(GeometryError::Invalid(format!(
+                "penalties P1 {} and P2 {}: need 0 < P1 <= P2 <= 1000",
+                self.p1, self.p2
+            )));
         }
         let (w, h) = left.size();
         if w < cw || h < ch || w < 2 {
@@ -159,21 +162,43 @@ fn census_generic<M: Madd>(img: &Plane<u8>, width: usize, height: usize, out: &m
 dispatch_kernel!(fn census_kernel => census_generic(img: &Plane<u8>, width: usize, height: usize, out: &mut Plane<u64>));
 
 /// One path step at one pixel: `cur[d + 1]` from `prev[d..d + 3]` (padded by one on each
-/// side with a large value) and the cost; returns the minimum of `cur`.
+/// side with a large value) and the cost, stored into (`store`) or added to `sum`; returns the
+/// minimum of `cur`.
 #[inline(always)]
-fn path_step(cost: &[u8], prev: &[u16], prev_min: u16, cur: &mut [u16], p1: u16, p2: u16) -> u16 {
+#[allow(clippy::too_many_arguments)]
+fn path_step_sum<const K: usize>(
+    cost: &[u8],
+    prev: &[u16],
+    prev_min: u16,
+    cur: &mut [u16],
+    sum: &mut [u16],
+    p1: u16,
+    p2: u16,
+    store: bool,
+) -> u16 {
     let lim = prev_min.saturating_add(p2);
     let mut m = u16::MAX;
-    let n = cost.len();
-    let (prev, cur) = (&prev[..n + 2], &mut cur[..n + 2]);
+    // K > 0: the disparity count known at compile time (fully unrolled loop).
+    let n = if K > 0 { K } else { cost.len() };
+    let (cost, prev, cur, sum) = (&cost[..n], &prev[..n + 2], &mut cur[..n + 2], &mut sum[..n]);
+    // Storing is adding to zero: a mask instead of a branch keeps the loop vectorized.
+    let keep = if store { 0 } else { u16::MAX };
     for d in 0..n {
         let near = prev[d].min(prev[d + 2]).saturating_add(p1);
         let v = prev[d + 1].min(near).min(lim);
         let val = cost[d] as u16 + v - prev_min;
         cur[d + 1] = val;
         m = m.min(val);
+        sum[d] = (sum[d] & keep).saturating_add(val);
     }
     m
+}
+
+/// [`path_step_sum`] without the sum (tests).
+#[cfg(test)]
+fn path_step(cost: &[u8], prev: &[u16], prev_min: u16, cur: &mut [u16], p1: u16, p2: u16) -> u16 {
+    let mut sum = vec![0u16; cost.len()];
+    path_step_sum::<0>(cost, prev, prev_min, cur, &mut sum, p1, p2, true)
 }
 
 /// Large value for the padding of path buffers (never chosen; adding P1 cannot overflow).
@@ -220,7 +245,29 @@ impl PassBuffers {
 /// One aggregation pass: rows in `forward` order (top to bottom, pixels left to right) or
 /// reversed; adds every path's L into `sum` (or stores it when `first`).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn pass_generic<M: Madd>(
+    cost: &[u8],
+    sum: &mut [u16],
+    w: usize,
+    h: usize,
+    d: usize,
+    p1: u16,
+    p2: u16,
+    diagonals: bool,
+    forward: bool,
+) {
+    match d {
+        64 => pass_d::<64>(cost, sum, w, h, d, p1, p2, diagonals, forward),
+        128 => pass_d::<128>(cost, sum, w, h, d, p1, p2, diagonals, forward),
+        _ => pass_d::<0>(cost, sum, w, h, d, p1, p2, diagonals, forward),
+    }
+}
+
+/// [`pass_generic`] for `K` disparities known at compile time (0: any).
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn pass_d<const K: usize>(
     cost: &[u8],
     sum: &mut [u16],
     w: usize,
@@ -247,28 +294,21 @@ fn pass_generic<M: Madd>(
             let s = &mut sum[(y * w + x) * d..(y * w + x + 1) * d];
             // Horizontal path.
             let m = if step_x == 0 {
-                path_step(c, &b.zeros, 0, &mut b.h_cur, p1, p2)
+                path_step_sum::<K>(c, &b.zeros, 0, &mut b.h_cur, s, p1, p2, forward)
             } else {
-                path_step(c, &b.h_prev, h_min, &mut b.h_cur, p1, p2)
+                path_step_sum::<K>(c, &b.h_prev, h_min, &mut b.h_cur, s, p1, p2, forward)
             };
             h_min = m;
             std::mem::swap(&mut b.h_prev, &mut b.h_cur);
-            let hp = &b.h_prev[1..d + 1];
-            if forward {
-                s.copy_from_slice(hp);
-            } else {
-                s.iter_mut().zip(hp).for_each(|(a, v)| *a = a.saturating_add(*v));
-            }
             for (k, &off) in offsets.iter().take(vertical_paths).enumerate() {
                 let px = step_x as isize + off;
                 let from = (step_y > 0 && px >= 0 && (px as usize) < w).then_some(px as usize);
                 let cur = &mut b.cur[k][step_x * dp..(step_x + 1) * dp];
-                let m = match from {
-                    Some(px) => path_step(c, &b.prev[k][px * dp..(px + 1) * dp], b.prev_min[k][px], cur, p1, p2),
-                    None => path_step(c, &b.zeros, 0, cur, p1, p2),
+                let (prev, prev_min) = match from {
+                    Some(px) => (&b.prev[k][px * dp..(px + 1) * dp], b.prev_min[k][px]),
+                    None => (&b.zeros[..], 0),
                 };
-                b.cur_min[k][step_x] = m;
-                s.iter_mut().zip(&cur[1..d + 1]).for_each(|(a, v)| *a = a.saturating_add(*v));
+                b.cur_min[k][step_x] = path_step_sum::<K>(c, prev, prev_min, cur, s, p1, p2, false);
             }
         }
         for k in 0..vertical_paths {
@@ -363,7 +403,9 @@ impl SgmMatcher {
             .checked_mul(height)
             .and_then(|v| v.checked_mul(params.max_disparity))
             .filter(|&v| v <= 1 << 32)
-            .ok_or_else(|| GeometryError::Invalid(format!("cost volume {width}x{height}x{} is too large", params.max_disparity)))?;
+            .ok_or_else(|| {
+            GeometryError::Invalid(format!("cost volume {width}x{height}x{} is too large", params.max_disparity))
+        })?;
         Ok(Self {
             params,
             size: (width, height),
@@ -631,7 +673,11 @@ mod tests {
         let left = Plane::from_fn(160, 80, |x, y| f(x as f64, y as f64));
         let right = Plane::from_fn(160, 80, |x, y| f(x as f64 + 7.3, y as f64));
         let est = sgm(&left, &right, &Sgm { max_disparity: 16, ..Default::default() }).unwrap();
-        let mut v: Vec<f32> = (10..70).flat_map(|y| (30..150).map(move |x| (x, y))).map(|(x, y)| est.get(x, y)).filter(|v| v.is_finite()).collect();
+        let mut v: Vec<f32> = (10..70)
+            .flat_map(|y| (30..150).map(move |x| (x, y)))
+            .map(|(x, y)| est.get(x, y))
+            .filter(|v| v.is_finite())
+            .collect();
         assert!(v.len() > 5000, "{} valid", v.len());
         v.sort_by(f32::total_cmp);
         let med = v[v.len() / 2];
