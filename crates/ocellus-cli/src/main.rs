@@ -70,8 +70,8 @@ enum Command {
     /// 3D points from pixel matches in two or more calibrated cameras (camera JSON files of
     /// `ocellus calibrate dlt`); flags points behind a camera.
     Triangulate(triangulate_cmd::TriangulateArgs),
-    /// Dense disparity of a rectified stereo pair by block matching; depth and a point cloud
-    /// with calibration; bad-2.0 against a ground-truth PFM.
+    /// Dense disparity of a rectified stereo pair by semi-global matching or block matching;
+    /// depth and a point cloud with calibration; bad-2.0 against a ground-truth PFM.
     Stereo(stereo_cmd::StereoArgs),
     /// Generate ground-truth sequences from the built-in real images.
     Generate(generate::GenerateArgs),

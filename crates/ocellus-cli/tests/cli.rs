@@ -360,7 +360,22 @@ fn stereo_writes_disparity_depth_cloud_and_scores_against_truth() {
     let s = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{s} {}", String::from_utf8_lossy(&o.stderr));
     let bad: f64 = s.split("bad-2.0 ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap();
-    assert!(bad < 27.0, "{s}");
+    // SGM by default (target 15 %); block matching on request (target 27 %).
+    assert!(bad < 15.0, "{s}");
+    let o = ocellus()
+        .arg("stereo")
+        .arg(d.join("motorcycle_left.png"))
+        .arg(d.join("motorcycle_right.png"))
+        .args(["--method", "bm", "--truth"])
+        .arg(d.join("motorcycle_disp.pfm"))
+        .arg("--out")
+        .arg(out.join("bm"))
+        .output()
+        .unwrap();
+    let sb = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success() && sb.contains("block matching"), "{sb}");
+    let bad_bm: f64 = sb.split("bad-2.0 ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap();
+    assert!(bad_bm < 27.0 && bad_bm > bad, "{sb}");
     let depth = ocellus_io::pfm::read(out.join("depth.pfm")).unwrap();
     let disp = ocellus_io::pfm::read(out.join("disparity.pfm")).unwrap();
     // Z = b f / (d + doffs) in millimetres, where a disparity exists.

@@ -5,15 +5,16 @@
 //!   a `census_width` x `census_height` window (at most 63 neighbours, one bit each: darker
 //!   than the centre). Census is invariant to monotonic brightness changes between the two
 //!   cameras, which real pairs have.
-//! - **Aggregation** along 4 (horizontal, vertical) or 8 (plus diagonals) straight paths:
+//! - **Aggregation** along 4 (horizontal, vertical) or 8 (plus diagonals) straight paths,
 //!   `L_r(p, d) = C(p, d) + min(L_r(p - r, d), L_r(p - r, d +- 1) + P1, min_k L_r(p - r, k) + P2)
-//!   - min_k L_r(p - r, k)`, summed over paths. Two passes over the image (paths arriving from
-//!   above and the left, then from below and the right), each keeping one previous row.
+//!   - min_k L_r(p - r, k)`, summed over the paths. Two passes over the image (paths arriving
+//!   from above and the left, then from below and the right), each keeping one previous row.
 //!   Costs are u16 and the inner loop over disparities is written for the compiler to
 //!   vectorize (AVX2 build chosen at run time).
-//! - **Selection:** winner-take-all on the summed cost, a uniqueness test, sub-pixel (equiangular fit),
-//!   a left-right check against the right image's winners (from the left winners, as
-//!   OpenCV's SGBM does), and a 3x3 median over valid neighbours. Invalid pixels are NaN.
+//! - **Selection:** winner-take-all on the summed cost, a uniqueness test, sub-pixel
+//!   (equiangular fit), a left-right check against the right image's winners (from the left
+//!   winners, as OpenCV's SGBM does), and optionally a 3x3 median over valid neighbours.
+//!   Invalid pixels are NaN.
 //! - [`SgmMatcher`] owns the cost volume and every buffer, for streams of pairs.
 //!
 //! Left pixel (x, y) with disparity d matches right pixel (x - d, y). For `x < d` there is no
