@@ -5,9 +5,10 @@
 //!   a `census_width` x `census_height` window (at most 63 neighbours, one bit each: darker
 //!   than the centre). Census is invariant to monotonic brightness changes between the two
 //!   cameras, which real pairs have.
-//! - **Aggregation** along 4 (horizontal, vertical) or 8 (plus diagonals) straight paths,
-//!   `L_r(p, d) = C(p, d) + min(L_r(p - r, d), L_r(p - r, d +- 1) + P1, min_k L_r(p - r, k) + P2)
-//!   - min_k L_r(p - r, k)`, summed over the paths. Two passes over the image (paths arriving
+//! - **Aggregation** along 4 (horizontal, vertical) or 8 (plus diagonals) straight paths, with
+//!   `m = min_k L_r(p - r, k)`,
+//!   `L_r(p, d) = C(p, d) + min(L_r(p - r, d), L_r(p - r, d +- 1) + P1, m + P2) - m`,
+//!   summed over the paths. Two passes over the image (paths arriving
 //!   from above and the left, then from below and the right), each keeping one previous row.
 //!   Costs are u16 and the inner loop over disparities is written for the compiler to
 //!   vectorize (AVX2 build chosen at run time).
