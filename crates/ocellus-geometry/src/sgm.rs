@@ -119,6 +119,8 @@ pub fn census(img: &Plane<u8>, width: usize, height: usize) -> Plane<u64> {
 }
 
 #[inline(always)]
+// The dispatch macro instantiates kernels per multiply-add flavour; integer kernels ignore it.
+#[allow(clippy::extra_unused_type_parameters)]
 fn census_generic<M: Madd>(img: &Plane<u8>, width: usize, height: usize, out: &mut Plane<u64>) {
     let (w, h) = img.size();
     let (hw, hh) = ((width / 2) as isize, (height / 2) as isize);
@@ -248,6 +250,8 @@ impl PassBuffers {
 /// reversed; adds every path's L into `sum` (or stores it when `first`).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
+// The dispatch macro instantiates kernels per multiply-add flavour; integer kernels ignore it.
+#[allow(clippy::extra_unused_type_parameters)]
 fn pass_generic<M: Madd>(
     cost: &[u8],
     sum: &mut [u16],
@@ -480,6 +484,8 @@ pub fn sgm(left: &Plane<u8>, right: &Plane<u8>, p: &Sgm) -> Result<Plane<f32>> {
 /// winners are taken, as in OpenCV's SGBM, from the left pixels' winners: right pixel
 /// x - d keeps the disparity d of the cheapest left pixel that chose it.
 #[inline(always)]
+// The dispatch macro instantiates kernels per multiply-add flavour; integer kernels ignore it.
+#[allow(clippy::extra_unused_type_parameters)]
 fn select_generic<M: Madd>(sum: &[u16], out: &mut Plane<f32>, p: &Sgm) {
     let (w, h) = out.size();
     let d = p.max_disparity;
