@@ -36,6 +36,7 @@ pub mod homography;
 pub mod sgm;
 pub mod stereo;
 pub mod triangulate;
+mod wta;
 pub mod zhang;
 
 use thiserror::Error;

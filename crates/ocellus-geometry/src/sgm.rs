@@ -22,6 +22,7 @@
 //! right pixel; the right image's first column stands in for the cost (replicated border),
 //! and such a disparity, if it wins, is reported invalid.
 
+use crate::wta::{select_row, SubPixel, WtaRule, WtaScratch};
 use crate::{GeometryError, Result};
 use ocellus_image::simd::Madd;
 use ocellus_image::{dispatch_kernel, Backend, Plane};
@@ -480,73 +481,21 @@ pub fn sgm(left: &Plane<u8>, right: &Plane<u8>, p: &Sgm) -> Result<Plane<f32>> {
     Ok(m.compute(left, right)?.clone())
 }
 
-/// Winner-take-all with uniqueness, sub-pixel and the left-right check. The right image's
-/// winners are taken, as in OpenCV's SGBM, from the left pixels' winners: right pixel
-/// x - d keeps the disparity d of the cheapest left pixel that chose it.
+/// Winner-take-all with uniqueness, sub-pixel and the left-right check ([`crate::wta`]), row
+/// by row.
 #[inline(always)]
 // The dispatch macro instantiates kernels per multiply-add flavour; integer kernels ignore it.
 #[allow(clippy::extra_unused_type_parameters)]
 fn select_generic<M: Madd>(sum: &[u16], out: &mut Plane<f32>, p: &Sgm) {
     let (w, h) = out.size();
     let d = p.max_disparity;
-    let mut best_of = vec![0usize; w];
-    let mut right_best = vec![usize::MAX; w];
-    let mut right_cost = vec![u16::MAX; w];
+    // Uniqueness needs at least three possible disparities (x >= 2). Equiangular sub-pixel:
+    // on a shifted smooth texture its mean error is 0.18 px against 0.23 px for a parabola
+    // (test below); both are pulled toward integers by the census cost and P1.
+    let rule = WtaRule { margin: p.uniqueness, lr_max_diff: p.lr_max_diff, subpixel: SubPixel::Equiangular, x_min: 2, x_max: w };
+    let mut scratch = WtaScratch::default();
     for y in 0..h {
-        right_cost.fill(u16::MAX);
-        right_best.fill(usize::MAX);
-        let row = out.row_mut(y);
-        for x in 0..w {
-            let s = &sum[(y * w + x) * d..(y * w + x + 1) * d];
-            // Cost and index packed in one word: the minimum gives both (first index on ties).
-            let mut packed = u32::MAX;
-            for (k, &v) in (0u32..).zip(s) {
-                packed = packed.min((v as u32) << 8 | k);
-            }
-            let (bc, best) = ((packed >> 8) as u16, (packed & 0xff) as usize);
-            // The cheapest disparity not adjacent to the best (a masked full-length loop, which
-            // vectorizes, rather than two loops of data-dependent length).
-            let (lo, hi) = (best.saturating_sub(1) as u16, (best + 1) as u16);
-            let mut other = u16::MAX;
-            for (k, &v) in (0u16..).zip(s) {
-                let far = k < lo || k > hi;
-                other = other.min(if far { v } else { u16::MAX });
-            }
-            // Uniqueness needs at least three possible disparities (x >= 2).
-            let ambiguous = (other as f32) * (1.0 - p.uniqueness) <= bc as f32;
-            best_of[x] = best;
-            if ambiguous || best > x || x < 2 {
-                row[x] = f32::NAN;
-                continue;
-            }
-            let mut disp = best as f32;
-            if best > 0 && best + 1 < d {
-                // Equiangular (V-shaped) fit: on a shifted smooth texture its mean error is
-                // 0.18 px against 0.23 px for a parabola (test below); both are pulled toward
-                // integers by the census cost and P1.
-                let (a, b, c) = (s[best - 1] as f32, bc as f32, s[best + 1] as f32);
-                let den = 2.0 * (a.max(c) - b);
-                if den > 0.0 {
-                    disp += (a - c) / den;
-                }
-            }
-            row[x] = disp;
-            let xr = x - best;
-            if bc < right_cost[xr] {
-                right_cost[xr] = bc;
-                right_best[xr] = best;
-            }
-        }
-        if p.lr_max_diff >= 0.0 {
-            for x in 0..w {
-                if row[x].is_finite() {
-                    let rb = right_best[x - best_of[x]];
-                    if rb == usize::MAX || (rb as f32 - best_of[x] as f32).abs() > p.lr_max_diff {
-                        row[x] = f32::NAN;
-                    }
-                }
-            }
-        }
+        select_row(&sum[y * w * d..(y + 1) * w * d], d, out.row_mut(y), &rule, &mut scratch);
     }
 }
 
