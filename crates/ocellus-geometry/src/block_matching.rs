@@ -18,8 +18,10 @@
 //!
 //! Left pixel (x, y) with disparity d matches right pixel (x - d, y) (Middlebury convention).
 
+use crate::wta::{select_row, SubPixel, WtaRule, WtaScratch};
 use crate::{GeometryError, Result};
-use ocellus_image::Plane;
+use ocellus_image::simd::Madd;
+use ocellus_image::{dispatch_kernel, Backend, Plane};
 
 /// Parameters of [`block_match`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,119 +86,119 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
     if p.block % 2 == 0 || p.block < 3 || p.max_disparity == 0 || !p.uniqueness.is_finite() || p.uniqueness < 0.0 {
         return Err(GeometryError::Invalid(format!("block matching {p:?}: odd block >= 3, max_disparity >= 1")));
     }
+    if p.max_disparity > 256 {
+        return Err(GeometryError::Invalid(format!("max_disparity {} must be at most 256", p.max_disparity)));
+    }
     let (w, h) = left.size();
-    let r = p.block / 2;
     if w < p.block || h < p.block {
         return Err(GeometryError::Invalid(format!("image {w}x{h} smaller than the {0}x{0} block", p.block)));
     }
-    let nd = p.max_disparity.min(w);
-    let mut out = Plane::from_fn(w, h, |_, _| f32::NAN);
-    // colsum[d * w + x]: sum over the block's rows of |L(x, .) - R(x - d, .)|.
-    let mut colsum = vec![0u32; nd * w];
-    let diff =
-        |y: usize, x: usize, d: usize| -> u32 { (left.row(y)[x] as i32 - right.row(y)[x - d] as i32).unsigned_abs() };
-    for yy in 0..p.block {
-        for d in 0..nd {
-            for x in d..w {
-                colsum[d * w + x] += diff(yy, x, d);
-            }
-        }
+    // Costs are u16: the largest window sum must fit.
+    let top = left.to_vec().into_iter().chain(right.to_vec()).max().unwrap_or(0) as usize;
+    if p.block * p.block * top > u16::MAX as usize - 1 {
+        return Err(GeometryError::Invalid(format!(
+            "block {0}x{0} with grey values up to {top} overflows 16-bit costs: use a smaller block or the prefilter",
+            p.block
+        )));
     }
-    // cost[d * w + x] for the current row (contiguous per disparity for the box sums).
-    let big = u32::MAX / 4;
-    let mut cost = vec![big; w * nd];
-    let (mut best_v, mut best_d) = (vec![0u32; w], vec![0u32; w]);
-    let (mut right_v, mut right_d) = (vec![0u32; w], vec![0u32; w]);
-    let mut ambiguous = vec![false; w];
-    for y in r..h - r {
-        if y > r {
-            // Slide the column sums down one row.
-            let (add, sub) = (y + r, y - r - 1);
-            for d in 0..nd {
-                let (la, ra, ls, rs) = (left.row(add), right.row(add), left.row(sub), right.row(sub));
-                let cs = &mut colsum[d * w + d..(d + 1) * w];
-                // Zipped slices: no bounds checks, so the loop vectorizes.
-                let it = cs.iter_mut().zip(&la[d..]).zip(&ra[..w - d]).zip(ls[d..].iter().zip(&rs[..w - d]));
-                for (((c, &a1), &a2), (&s1, &s2)) in it {
-                    let a = (a1 as i32 - a2 as i32).unsigned_abs();
-                    let s = (s1 as i32 - s2 as i32).unsigned_abs();
-                    *c = *c + a - s;
-                }
-            }
-        }
-        // Horizontal box sums: windows centred at x need columns x - r ..= x + r >= d.
-        cost.fill(big);
-        for d in 0..nd {
-            let cs = &colsum[d * w..(d + 1) * w];
-            let x0 = d + r;
-            if x0 + r >= w {
-                continue;
-            }
-            let mut s: u32 = cs[x0 - r..=x0 + r].iter().sum();
-            let out = &mut cost[d * w..(d + 1) * w];
-            out[x0] = s;
-            let (adds, subs) = (&cs[x0 + r + 1..], &cs[x0 - r..w - 2 * r - 1]);
-            for ((o, &a), &b) in out[x0 + 1..w - r].iter_mut().zip(adds).zip(subs) {
-                s = s + a - b;
-                *o = s;
-            }
-        }
-        // Per-row passes over the disparities (contiguous, vectorizable), in the order a
-        // per-pixel scan would visit them, so ties resolve the same way (first minimum).
-        best_v.fill(u32::MAX);
-        best_d.fill(0);
-        right_v.fill(u32::MAX);
-        right_d.fill(0);
-        for d in 0..nd {
-            let cd = &cost[d * w..(d + 1) * w];
-            for (x, &v) in cd.iter().enumerate() {
-                if v < best_v[x] {
-                    best_v[x] = v;
-                    best_d[x] = d as u32;
-                }
-            }
-            // Right pixel xr matches left pixel xr + d at disparity d.
-            for (xr, &v) in cd[d..].iter().enumerate() {
-                if v < right_v[xr] {
-                    right_v[xr] = v;
-                    right_d[xr] = d as u32;
-                }
-            }
-        }
-        ambiguous.fill(false);
-        for d in 0..nd {
-            let cd = &cost[d * w..(d + 1) * w];
-            for (x, &v) in cd.iter().enumerate() {
-                let limit = best_v[x] as f32 * (1.0 + p.uniqueness);
-                let far = (d as u32).abs_diff(best_d[x]) > 1;
-                ambiguous[x] |= far && (v as f32) <= limit && v < big;
-            }
-        }
-        let row = out.row_mut(y);
-        for x in (nd - 1 + r)..w - r {
-            let (bd, best) = (best_d[x] as usize, best_v[x]);
-            if best >= big || ambiguous[x] {
-                continue;
-            }
-            if p.lr_max_diff >= 0.0 && (right_d[x - bd] as f32 - bd as f32).abs() > p.lr_max_diff {
-                continue;
-            }
-            // Sub-pixel: vertex of the parabola through d - 1, d, d + 1.
-            let mut dsub = bd as f32;
-            if bd > 0 && bd + 1 < nd {
-                let (cm, cp) = (cost[(bd - 1) * w + x], cost[(bd + 1) * w + x]);
-                if cm < big && cp < big {
-                    let den = cm as f32 + cp as f32 - 2.0 * best as f32;
-                    if den > 0.0 {
-                        dsub += 0.5 * (cm as f32 - cp as f32) / den;
-                    }
-                }
-            }
-            row[x] = dsub;
-        }
-    }
+    let mut out = Plane::new(w, h);
+    sad_kernel(Backend::Auto, left, right, p, &mut out);
     Ok(out)
 }
+
+/// SAD costs `[x][d]` row by row from running sums, and the winner per pixel.
+#[inline(always)]
+// The dispatch macro instantiates kernels per multiply-add flavour; integer kernels ignore it.
+#[allow(clippy::extra_unused_type_parameters)]
+fn sad_generic<M: Madd>(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, out: &mut Plane<f32>) {
+    let (w, h) = left.size();
+    let r = p.block / 2;
+    let nd = p.max_disparity.min(w);
+    // Right rows reversed, so that disparities run forward through memory:
+    // reversed[w - 1 - x + d] = right[x - d].
+    let reversed = |y: usize| -> Vec<u8> { right.row(y).iter().rev().copied().collect() };
+    // colsum[x * nd + d]: sum over the window's rows of |L(x, .) - R(x - d, .)| (d <= x;
+    // the other lanes stay 0, so the wrapping box sums below are exact where used).
+    let mut colsum = vec![0u16; w * nd];
+    let add_row = |colsum: &mut [u16], y: usize, sign_add: bool| {
+        let (l, rr) = (left.row(y), reversed(y));
+        for x in 0..w {
+            let valid = nd.min(x + 1);
+            let base = w - 1 - x;
+            let lx = l[x];
+            let cs = &mut colsum[x * nd..x * nd + valid];
+            for (c, &rv) in cs.iter_mut().zip(&rr[base..base + valid]) {
+                let a = lx.abs_diff(rv) as u16;
+                *c = if sign_add { c.wrapping_add(a) } else { c.wrapping_sub(a) };
+            }
+        }
+    };
+    for yy in 0..p.block {
+        add_row(&mut colsum, yy, true);
+    }
+    let mut cost = vec![0u16; w * nd];
+    let rule = WtaRule {
+        // "cost <= best (1 + u)" is "cost (1 - u / (1 + u)) <= best".
+        margin: p.uniqueness / (1.0 + p.uniqueness),
+        lr_max_diff: p.lr_max_diff,
+        subpixel: SubPixel::Parabola,
+        x_min: nd - 1 + r,
+        x_max: w - r,
+    };
+    let mut scratch = WtaScratch::default();
+    let (mut l_add, mut r_add, mut l_sub, mut r_sub) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for y in 0..h {
+        if y < r || y + r >= h {
+            out.row_mut(y).fill(f32::NAN);
+            continue;
+        }
+        if y > r {
+            // Slide the column sums down one row: add row y + r, remove row y - r - 1.
+            let (add, sub) = (y + r, y - r - 1);
+            l_add.clear();
+            l_add.extend_from_slice(left.row(add));
+            l_sub.clear();
+            l_sub.extend_from_slice(left.row(sub));
+            r_add.clear();
+            r_add.extend(right.row(add).iter().rev());
+            r_sub.clear();
+            r_sub.extend(right.row(sub).iter().rev());
+            for x in 0..w {
+                let valid = nd.min(x + 1);
+                let base = w - 1 - x;
+                let (la, ls) = (l_add[x], l_sub[x]);
+                let cs = &mut colsum[x * nd..x * nd + valid];
+                for ((c, &ra), &rs) in cs.iter_mut().zip(&r_add[base..base + valid]).zip(&r_sub[base..base + valid]) {
+                    *c = c.wrapping_add(la.abs_diff(ra) as u16).wrapping_sub(ls.abs_diff(rs) as u16);
+                }
+            }
+        }
+        // Box sums along x, all disparities at once: cost(x) = cost(x - 1) + col(x + r) -
+        // col(x - r - 1).
+        {
+            let (first, rest) = cost.split_at_mut((r + 1) * nd);
+            let c0 = &mut first[r * nd..];
+            c0.fill(0);
+            for xx in 0..=2 * r {
+                for (c, &v) in c0.iter_mut().zip(&colsum[xx * nd..(xx + 1) * nd]) {
+                    *c = c.wrapping_add(v);
+                }
+            }
+            let mut prev: &[u16] = c0;
+            for (i, cur) in rest.chunks_exact_mut(nd).enumerate().take(w - 2 * r - 1) {
+                let x = r + 1 + i;
+                let (a, b) = (&colsum[(x + r) * nd..(x + r + 1) * nd], &colsum[(x - r - 1) * nd..(x - r) * nd]);
+                for (((c, &pv), &av), &bv) in cur.iter_mut().zip(prev).zip(a).zip(b) {
+                    *c = pv.wrapping_add(av).wrapping_sub(bv);
+                }
+                prev = cur;
+            }
+        }
+        select_row(&cost, nd, out.row_mut(y), &rule, &mut scratch);
+    }
+}
+
+dispatch_kernel!(fn sad_kernel => sad_generic(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, out: &mut Plane<f32>));
 
 /// Share of pixels with known ground truth (finite) whose estimate is off by more than
 /// `threshold` pixels, invalid estimates counted as bad (Middlebury "bad-2.0" for 2), and the
