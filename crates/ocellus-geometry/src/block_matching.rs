@@ -50,16 +50,32 @@ impl Default for BlockMatching {
 /// `cap + clamp(sobel_x, -cap, cap)` per pixel (borders replicated).
 pub fn prefilter_xsobel(img: &Plane<u8>, cap: u8) -> Plane<u8> {
     let (w, h) = img.size();
-    let c = cap as i32;
-    Plane::from_fn(w, h, |x, y| {
-        let g = |dx: isize, dy: isize| {
-            let xx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
-            let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
-            img.row(yy)[xx] as i32
-        };
-        let s = (g(1, -1) - g(-1, -1)) + 2 * (g(1, 0) - g(-1, 0)) + (g(1, 1) - g(-1, 1));
-        (s.clamp(-c, c) + c) as u8
-    })
+    let c = cap as i16;
+    let mut out = Plane::new(w, h);
+    // Row by row: the vertical [1 2 1] of the horizontal differences, in i16 over padded rows.
+    let mut diff = [vec![0i16; w], vec![0i16; w], vec![0i16; w]];
+    let row_diff = |y: usize, d: &mut Vec<i16>| {
+        let r = img.row(y);
+        if w == 1 {
+            d[0] = 0;
+            return;
+        }
+        d[0] = r[1] as i16 - r[0] as i16;
+        d[w - 1] = r[w - 1] as i16 - r[w - 2] as i16;
+        for ((o, &a), &b) in d[1..w - 1].iter_mut().zip(&r[2..]).zip(&r[..w - 2]) {
+            *o = a as i16 - b as i16;
+        }
+    };
+    for y in 0..h {
+        for (k, dy) in [-1isize, 0, 1].into_iter().enumerate() {
+            row_diff((y as isize + dy).clamp(0, h as isize - 1) as usize, &mut diff[k]);
+        }
+        let [up, mid, down] = &diff;
+        for (((o, &a), &b), &cc) in out.row_mut(y).iter_mut().zip(up).zip(mid).zip(down) {
+            *o = ((a + 2 * b + cc).clamp(-c, c) + c) as u8;
+        }
+    }
+    out
 }
 
 /// Disparity of the left image: pixels, NaN where invalid.
@@ -265,6 +281,22 @@ mod tests {
         // Away from borders and object edges every estimate is exact.
         for (x, y, want) in [(30usize, 50usize, 7.0f32), (80, 50, 12.0), (130, 15, 7.0)] {
             assert!((est.get(x, y) - want).abs() < 0.1, "({x}, {y}): {}", est.get(x, y));
+        }
+    }
+
+    #[test]
+    fn prefilter_matches_a_direct_sobel() {
+        let mut rng = SplitMix64::new(6);
+        let img = Plane::from_fn(37, 23, |_, _| (rng.next_u64() & 255) as u8);
+        let f = prefilter_xsobel(&img, 31);
+        for y in 0..23 {
+            for x in 0..37 {
+                let g = |dx: isize, dy: isize| {
+                    img.get((x as isize + dx).clamp(0, 36) as usize, (y as isize + dy).clamp(0, 22) as usize) as i32
+                };
+                let s = (g(1, -1) - g(-1, -1)) + 2 * (g(1, 0) - g(-1, 0)) + (g(1, 1) - g(-1, 1));
+                assert_eq!(f.get(x, y) as i32, s.clamp(-31, 31) + 31, "({x}, {y})");
+            }
         }
     }
 
