@@ -110,7 +110,7 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
         return Err(GeometryError::Invalid(format!("image {w}x{h} smaller than the {0}x{0} block", p.block)));
     }
     // Costs are u16: the largest window sum must fit.
-    let top = left.to_vec().into_iter().chain(right.to_vec()).max().unwrap_or(0) as usize;
+    let top = left.rows().chain(right.rows()).map(|r| r.iter().copied().max().unwrap_or(0)).max().unwrap_or(0) as usize;
     if p.block * p.block * top > u16::MAX as usize - 1 {
         return Err(GeometryError::Invalid(format!(
             "block {0}x{0} with grey values up to {top} overflows 16-bit costs: use a smaller block or the prefilter",
@@ -185,7 +185,10 @@ fn sad_generic<M: Madd>(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, 
                 let (la, ls) = (l_add[x], l_sub[x]);
                 let cs = &mut colsum[x * nd..x * nd + valid];
                 for ((c, &ra), &rs) in cs.iter_mut().zip(&r_add[base..base + valid]).zip(&r_sub[base..base + valid]) {
-                    *c = c.wrapping_add(la.abs_diff(ra) as u16).wrapping_sub(ls.abs_diff(rs) as u16);
+                    // |a - b| as max - min in u8 lanes (32 per AVX2 register), then widened.
+                    let a = (la.max(ra) - la.min(ra)) as u16;
+                    let b = (ls.max(rs) - ls.min(rs)) as u16;
+                    *c = c.wrapping_add(a).wrapping_sub(b);
                 }
             }
         }

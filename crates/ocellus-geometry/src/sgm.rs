@@ -492,7 +492,13 @@ fn select_generic<M: Madd>(sum: &[u16], out: &mut Plane<f32>, p: &Sgm) {
     // Uniqueness needs at least three possible disparities (x >= 2). Equiangular sub-pixel:
     // on a shifted smooth texture its mean error is 0.18 px against 0.23 px for a parabola
     // (test below); both are pulled toward integers by the census cost and P1.
-    let rule = WtaRule { margin: p.uniqueness, lr_max_diff: p.lr_max_diff, subpixel: SubPixel::Equiangular, x_min: 2, x_max: w };
+    let rule = WtaRule {
+        margin: p.uniqueness,
+        lr_max_diff: p.lr_max_diff,
+        subpixel: SubPixel::Equiangular,
+        x_min: 2,
+        x_max: w,
+    };
     let mut scratch = WtaScratch::default();
     for y in 0..h {
         select_row(&sum[y * w * d..(y + 1) * w * d], d, out.row_mut(y), &rule, &mut scratch);
