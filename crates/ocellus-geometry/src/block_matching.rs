@@ -124,8 +124,6 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
 
 /// SAD costs `[x][d]` row by row from running sums, and the winner per pixel.
 #[inline(always)]
-// The dispatch macro instantiates kernels per multiply-add flavour; integer kernels ignore it.
-#[allow(clippy::extra_unused_type_parameters)]
 fn sad_generic<M: Madd>(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, out: &mut Plane<f32>) {
     let (w, h) = left.size();
     let r = p.block / 2;
@@ -213,7 +211,7 @@ fn sad_generic<M: Madd>(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, 
                 prev = cur;
             }
         }
-        select_row(&cost, nd, out.row_mut(y), &rule, &mut scratch);
+        select_row::<M>(&cost, nd, out.row_mut(y), &rule, &mut scratch);
     }
 }
 

@@ -484,8 +484,6 @@ pub fn sgm(left: &Plane<u8>, right: &Plane<u8>, p: &Sgm) -> Result<Plane<f32>> {
 /// Winner-take-all with uniqueness, sub-pixel and the left-right check ([`crate::wta`]), row
 /// by row.
 #[inline(always)]
-// The dispatch macro instantiates kernels per multiply-add flavour; integer kernels ignore it.
-#[allow(clippy::extra_unused_type_parameters)]
 fn select_generic<M: Madd>(sum: &[u16], out: &mut Plane<f32>, p: &Sgm) {
     let (w, h) = out.size();
     let d = p.max_disparity;
@@ -501,7 +499,7 @@ fn select_generic<M: Madd>(sum: &[u16], out: &mut Plane<f32>, p: &Sgm) {
     };
     let mut scratch = WtaScratch::default();
     for y in 0..h {
-        select_row(&sum[y * w * d..(y + 1) * w * d], d, out.row_mut(y), &rule, &mut scratch);
+        select_row::<M>(&sum[y * w * d..(y + 1) * w * d], d, out.row_mut(y), &rule, &mut scratch);
     }
 }
 

@@ -73,6 +73,10 @@ pub fn avx2_available() -> bool {
 
 /// How a kernel computes `a * b + c`.
 pub trait Madd {
+    /// True for the flavour that [`dispatch_kernel!`] instantiates only inside functions
+    /// compiled with AVX2 and FMA: kernels may then call `#[target_feature(enable = "avx2")]`
+    /// helpers (explicit intrinsics) without a further check.
+    const AVX2: bool;
     /// `a * b + c`, fused or not.
     fn madd(a: f32, b: f32, c: f32) -> f32;
 }
@@ -80,6 +84,7 @@ pub trait Madd {
 /// Separate multiply and add: portable, no FMA instruction needed.
 pub struct Plain;
 impl Madd for Plain {
+    const AVX2: bool = false;
     #[inline(always)]
     fn madd(a: f32, b: f32, c: f32) -> f32 {
         a * b + c
@@ -89,6 +94,7 @@ impl Madd for Plain {
 /// Fused multiply-add; only used inside functions compiled with the `fma` feature.
 pub struct Fused;
 impl Madd for Fused {
+    const AVX2: bool = true;
     #[inline(always)]
     fn madd(a: f32, b: f32, c: f32) -> f32 {
         a.mul_add(b, c)
