@@ -44,6 +44,7 @@ pub(crate) struct WtaRule {
 /// Reusable per-row buffers of [`select_row`].
 #[derive(Clone, Debug, Default)]
 pub(crate) struct WtaScratch {
+    keep: u64,
     best_of: Vec<usize>,
     right_best: Vec<usize>,
     right_cost: Vec<u16>,
@@ -138,26 +139,42 @@ unsafe fn hmin_avx2(v: &[std::arch::x86_64::__m256i; 4]) -> u16 {
 #[inline(always)]
 pub(crate) fn select_row<M: Madd>(costs: &[u16], d: usize, row: &mut [f32], rule: &WtaRule, s: &mut WtaScratch) {
     let w = row.len();
-    s.best_of.clear();
-    s.best_of.resize(w, usize::MAX);
-    s.right_best.clear();
-    s.right_best.resize(w, usize::MAX);
-    s.right_cost.clear();
-    s.right_cost.resize(w, u16::MAX);
-    row.fill(f32::NAN);
-    // The uniqueness test in integers: other (1 - margin) <= best, with 1 - margin in 1/65536.
-    let keep = ((1.0 - rule.margin.clamp(0.0, 1.0)) * 65536.0).round() as u64;
+    s.begin(row, rule);
     for x in rule.x_min..rule.x_max.min(w) {
-        let c = &costs[x * d..(x + 1) * d];
+        s.pixel::<M>(x, &costs[x * d..(x + 1) * d], row, rule);
+    }
+    s.finish(row, rule);
+}
+
+impl WtaScratch {
+    /// Starts a row: everything invalid until [`WtaScratch::pixel`] says otherwise.
+    #[inline(always)]
+    pub(crate) fn begin(&mut self, row: &mut [f32], rule: &WtaRule) {
+        let w = row.len();
+        self.best_of.clear();
+        self.best_of.resize(w, usize::MAX);
+        self.right_best.clear();
+        self.right_best.resize(w, usize::MAX);
+        self.right_cost.clear();
+        self.right_cost.resize(w, u16::MAX);
+        row.fill(f32::NAN);
+        // The uniqueness test in integers: other (1 - margin) <= best, 1 - margin in 1/65536.
+        self.keep = ((1.0 - rule.margin.clamp(0.0, 1.0)) * 65536.0).round() as u64;
+    }
+
+    /// Selects pixel `x` (inside `rule.x_min..rule.x_max`) from its `d` costs.
+    #[inline(always)]
+    pub(crate) fn pixel<M: Madd>(&mut self, x: usize, c: &[u16], row: &mut [f32], rule: &WtaRule) {
+        let d = c.len();
         #[cfg(target_arch = "x86_64")]
         // SAFETY: M::AVX2 is true only inside AVX2 builds (dispatch_kernel!); c has 64 values.
         let (bc, best, other) =
             if M::AVX2 && d == 64 { unsafe { best_and_other_64_avx2(c) } } else { best_and_other(c) };
         #[cfg(not(target_arch = "x86_64"))]
         let (bc, best, other) = best_and_other(c);
-        let ambiguous = other as u64 * keep <= (bc as u64) << 16;
+        let ambiguous = other as u64 * self.keep <= (bc as u64) << 16;
         if ambiguous || bc == u16::MAX || best > x {
-            continue;
+            return;
         }
         let mut disp = best as f32;
         if best > 0 && best + 1 < d && c[best - 1] != u16::MAX && c[best + 1] != u16::MAX {
@@ -182,18 +199,24 @@ pub(crate) fn select_row<M: Madd>(costs: &[u16], d: usize, row: &mut [f32], rule
             };
         }
         row[x] = disp;
-        s.best_of[x] = best;
+        self.best_of[x] = best;
         let xr = x - best;
-        if bc < s.right_cost[xr] {
-            s.right_cost[xr] = bc;
-            s.right_best[xr] = best;
+        if bc < self.right_cost[xr] {
+            self.right_cost[xr] = bc;
+            self.right_best[xr] = best;
         }
     }
-    if rule.lr_max_diff >= 0.0 {
-        for x in 0..w {
+
+    /// Ends a row: the left-right check.
+    #[inline(always)]
+    pub(crate) fn finish(&mut self, row: &mut [f32], rule: &WtaRule) {
+        if rule.lr_max_diff < 0.0 {
+            return;
+        }
+        for x in 0..row.len() {
             if row[x].is_finite() {
-                let rb = s.right_best[x - s.best_of[x]];
-                if rb == usize::MAX || (rb as f32 - s.best_of[x] as f32).abs() > rule.lr_max_diff {
+                let rb = self.right_best[x - self.best_of[x]];
+                if rb == usize::MAX || (rb as f32 - self.best_of[x] as f32).abs() > rule.lr_max_diff {
                     row[x] = f32::NAN;
                 }
             }
