@@ -18,7 +18,7 @@
 //!
 //! Left pixel (x, y) with disparity d matches right pixel (x - d, y) (Middlebury convention).
 
-use crate::wta::{select_row, SubPixel, WtaRule, WtaScratch};
+use crate::wta::{SubPixel, WtaRule, WtaScratch};
 use crate::{GeometryError, Result};
 use ocellus_image::simd::Madd;
 use ocellus_image::{dispatch_kernel, Backend, Plane};
@@ -150,7 +150,7 @@ fn sad_generic<M: Madd>(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, 
     for yy in 0..p.block {
         add_row(&mut colsum, yy, true);
     }
-    let mut cost = vec![0u16; w * nd];
+    let mut cost = vec![0u16; nd];
     let rule = WtaRule {
         // "cost <= best (1 + u)" is "cost (1 - u / (1 + u)) <= best".
         margin: p.uniqueness / (1.0 + p.uniqueness),
@@ -190,28 +190,28 @@ fn sad_generic<M: Madd>(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, 
                 }
             }
         }
-        // Box sums along x, all disparities at once: cost(x) = cost(x - 1) + col(x + r) -
-        // col(x - r - 1).
-        {
-            let (first, rest) = cost.split_at_mut((r + 1) * nd);
-            let c0 = &mut first[r * nd..];
-            c0.fill(0);
-            for xx in 0..=2 * r {
-                for (c, &v) in c0.iter_mut().zip(&colsum[xx * nd..(xx + 1) * nd]) {
-                    *c = c.wrapping_add(v);
-                }
-            }
-            let mut prev: &[u16] = c0;
-            for (i, cur) in rest.chunks_exact_mut(nd).enumerate().take(w - 2 * r - 1) {
-                let x = r + 1 + i;
-                let (a, b) = (&colsum[(x + r) * nd..(x + r + 1) * nd], &colsum[(x - r - 1) * nd..(x - r) * nd]);
-                for (((c, &pv), &av), &bv) in cur.iter_mut().zip(prev).zip(a).zip(b) {
-                    *c = pv.wrapping_add(av).wrapping_sub(bv);
-                }
-                prev = cur;
+        // Box sums along x, all disparities at once (cost(x) = cost(x - 1) + col(x + r) -
+        // col(x - r - 1)), each pixel selected as soon as its sums are known.
+        let row = out.row_mut(y);
+        scratch.begin(row, &rule);
+        cost.fill(0);
+        for xx in 0..=2 * r {
+            for (c, &v) in cost.iter_mut().zip(&colsum[xx * nd..(xx + 1) * nd]) {
+                *c = c.wrapping_add(v);
             }
         }
-        select_row::<M>(&cost, nd, out.row_mut(y), &rule, &mut scratch);
+        for x in r..w - r {
+            if x > r {
+                let (a, b) = (&colsum[(x + r) * nd..(x + r + 1) * nd], &colsum[(x - r - 1) * nd..(x - r) * nd]);
+                for ((c, &av), &bv) in cost.iter_mut().zip(a).zip(b) {
+                    *c = c.wrapping_add(av).wrapping_sub(bv);
+                }
+            }
+            if x >= rule.x_min && x < rule.x_max {
+                scratch.pixel::<M>(x, &cost, row, &rule);
+            }
+        }
+        scratch.finish(row, &rule);
     }
 }
 
