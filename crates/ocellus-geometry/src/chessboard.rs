@@ -23,6 +23,7 @@
 
 use crate::{GeometryError, Result};
 use ocellus_image::filter::gaussian_blur;
+use ocellus_image::resample::sample_bilinear as sample;
 use ocellus_image::Plane;
 use std::collections::HashMap;
 
@@ -56,17 +57,6 @@ pub struct Saddle {
     pub dir_b: [f64; 2],
     /// Saddle response at the pixel maximum.
     pub response: f32,
-}
-
-fn sample(img: &Plane<f32>, x: f32, y: f32) -> f32 {
-    let (w, h) = (img.width() as f32, img.height() as f32);
-    let (x, y) = (x.clamp(0.0, w - 1.0), y.clamp(0.0, h - 1.0));
-    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-    let (x1, y1) = ((x0 + 1).min(img.width() - 1), (y0 + 1).min(img.height() - 1));
-    let (ax, ay) = (x - x0 as f32, y - y0 as f32);
-    let top = img.get(x0, y0) + ax * (img.get(x1, y0) - img.get(x0, y0));
-    let bot = img.get(x0, y1) + ax * (img.get(x1, y1) - img.get(x0, y1));
-    top + ay * (bot - top)
 }
 
 /// The ring test: the two edge directions if the ring around (x, y) crosses its mean four

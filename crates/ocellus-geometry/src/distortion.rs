@@ -116,12 +116,7 @@ pub fn remap_bilinear(
         if !(u >= 0.0 && v >= 0.0 && u <= w - 1.0 && v <= h - 1.0) {
             return fill;
         }
-        let (x0, y0) = (u.floor() as usize, v.floor() as usize);
-        let (x1, y1) = ((x0 + 1).min(src.width() - 1), (y0 + 1).min(src.height() - 1));
-        let (ax, ay) = (u - x0 as f32, v - y0 as f32);
-        let top = src.get(x0, y0) + ax * (src.get(x1, y0) - src.get(x0, y0));
-        let bot = src.get(x0, y1) + ax * (src.get(x1, y1) - src.get(x0, y1));
-        top + ay * (bot - top)
+        ocellus_image::resample::sample_bilinear(src, u, v)
     }))
 }
 

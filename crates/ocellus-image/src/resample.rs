@@ -129,6 +129,20 @@ dispatch_kernel!(fn resample_kernel => resample_generic(
     xs: &AxisTable, ys: &AxisTable, src: &Plane<f32>, dst: &mut Plane<f32>, row: &mut Vec<f32>
 ));
 
+/// Bilinear sample of `img` at (x, y), pixel centres at integers; positions outside the image
+/// are clamped to its border (a non-empty image is assumed).
+#[inline]
+pub fn sample_bilinear(img: &Plane<f32>, x: f32, y: f32) -> f32 {
+    let (w, h) = (img.width() as f32, img.height() as f32);
+    let (x, y) = (x.clamp(0.0, w - 1.0), y.clamp(0.0, h - 1.0));
+    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+    let (x1, y1) = ((x0 + 1).min(img.width() - 1), (y0 + 1).min(img.height() - 1));
+    let (ax, ay) = (x - x0 as f32, y - y0 as f32);
+    let top = img.get(x0, y0) + ax * (img.get(x1, y0) - img.get(x0, y0));
+    let bot = img.get(x0, y1) + ax * (img.get(x1, y1) - img.get(x0, y1));
+    top + ay * (bot - top)
+}
+
 /// Allocating convenience: resample `src` to `w` x `h`.
 pub fn resize(src: &Plane<f32>, w: usize, h: usize, method: ResampleMethod) -> Result<Plane<f32>> {
     let r = Resampler::new(method, src.size(), (w, h))?;
