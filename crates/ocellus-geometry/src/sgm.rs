@@ -625,8 +625,9 @@ mod tests {
         // A band-limited texture (sum of sinusoids) shifted by 7.3 px: sub-pixel estimates
         // must beat integer ones (whose error would be 0.3 px everywhere).
         let mut rng = SplitMix64::new(3);
-        let waves: Vec<(f64, f64, f64)> =
-            (0..12).map(|_| (0.05 + 0.5 * rng.unit(), 0.05 + 0.5 * rng.unit(), rng.unit() * 6.28)).collect();
+        let waves: Vec<(f64, f64, f64)> = (0..12)
+            .map(|_| (0.05 + 0.5 * rng.unit(), 0.05 + 0.5 * rng.unit(), rng.unit() * std::f64::consts::TAU))
+            .collect();
         let f = |x: f64, y: f64| {
             let v: f64 = waves.iter().map(|(a, b, p)| (a * x + b * y + p).sin()).sum();
             (128.0 + 9.0 * v).clamp(0.0, 255.0) as u8

@@ -4,6 +4,8 @@
 //!   sensor noise, an object that appears suddenly, a steady camera pan), with per-frame truth.
 //! - [`chessboard`]: views of a chessboard through a known distorted camera (calibration
 //!   ground truth).
+//! - [`ground`]: a camera looking down at a tiled real-texture floor with known planar motion
+//!   (visual odometry ground truth), and simulated wheel encoders.
 //! - [`corridor`]: a corridor with textured walls, poster landmarks and a person, rendered by
 //!   a pinhole camera with a pan angle (view-planning experiments).
 //!
@@ -27,6 +29,7 @@
 pub mod attention_scenes;
 pub mod chessboard;
 pub mod corridor;
+pub mod ground;
 pub mod texture;
 
 use thiserror::Error;
