@@ -23,6 +23,7 @@
 pub mod csv;
 pub mod npy;
 pub mod pfm;
+pub mod tum;
 pub mod ply;
 pub mod points;
 pub mod video;
