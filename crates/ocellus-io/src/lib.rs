@@ -23,9 +23,9 @@
 pub mod csv;
 pub mod npy;
 pub mod pfm;
-pub mod tum;
 pub mod ply;
 pub mod points;
+pub mod tum;
 pub mod video;
 pub mod y4m;
 

@@ -37,7 +37,10 @@ impl TumPose {
 pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<TumPose>> {
     let rows = parse_rows(bytes, path, 8, "'timestamp tx ty tz qx qy qz qw'")?;
     if rows.is_empty() {
-        return Err(IoError::Invalid { path: path.into(), reason: "no poses (lines 'timestamp tx ty tz qx qy qz qw')".into() });
+        return Err(IoError::Invalid {
+            path: path.into(),
+            reason: "no poses (lines 'timestamp tx ty tz qx qy qz qw')".into(),
+        });
     }
     rows.iter()
         .enumerate()
@@ -83,7 +86,8 @@ mod tests {
     fn round_trip_and_yaw() {
         let dir = std::env::temp_dir().join(format!("ocellus-tum-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let poses: Vec<TumPose> = (0..5).map(|k| TumPose::planar(k as f64 * 0.005, 0.1 * k as f64, -0.02, 0.3 * k as f64 - 0.5)).collect();
+        let poses: Vec<TumPose> =
+            (0..5).map(|k| TumPose::planar(k as f64 * 0.005, 0.1 * k as f64, -0.02, 0.3 * k as f64 - 0.5)).collect();
         write(dir.join("t.tum"), &poses).unwrap();
         let back = read(dir.join("t.tum")).unwrap();
         for (a, b) in poses.iter().zip(&back) {

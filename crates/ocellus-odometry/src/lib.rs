@@ -1,0 +1,51 @@
+//! How the robot moved: visual odometry from a camera looking straight down at the floor
+//! (SPEC 6; seed 001, section 5).
+//!
+//! - [`sad_flow`]: the seed's elaborated SAD block matching: 400 search windows over the
+//!   central 400x400 pixels, border windows dropped, 3x3 groups with outlier rejection, 36
+//!   flow vectors.
+//! - [`kinematics`]: planar poses, and the camera-to-robot motion of seed eq. 20 (a camera
+//!   mounted off the rotation centre).
+//! - [`vo`]: the Kalman filter on the camera motion (Tx, Ty, wz) with the image-Jacobian
+//!   measurement model, in information form, and the integration to a robot trajectory.
+//!
+//! Conventions: image x right, y down, pixel centres at integers; flow positions relative to
+//! the principal point. The robot frame is (right, forward); headings turn clockwise seen
+//! from above (the image's sense). Lengths at the API are metres (camera height, mount
+//! offset, poses), angles radians; flows are pixels.
+//!
+//! ```
+//! use ocellus_odometry::kinematics::Pose2;
+//! let p = Pose2::default().step(0.0, 1.0, std::f64::consts::FRAC_PI_2);
+//! assert!((p.y + 1.0).abs() < 1e-12); // forward is -y at heading 0
+//! ```
+
+pub mod kinematics;
+pub mod sad_flow;
+pub mod vo;
+
+use thiserror::Error;
+
+/// Errors of the odometry crate.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum OdometryError {
+    /// A parameter is out of range.
+    #[error("invalid odometry parameter: {0}")]
+    Invalid(String),
+    /// Frames of different sizes, or too small for the configured windows.
+    #[error("frame is {got_w}x{got_h}: {why}")]
+    FrameSize {
+        /// Width.
+        got_w: usize,
+        /// Height.
+        got_h: usize,
+        /// What was expected.
+        why: String,
+    },
+    /// The image has too little texture to measure motion (e.g. a blank floor).
+    #[error("no reliable flow: {0}")]
+    NoTexture(String),
+}
+
+/// Result type of this crate.
+pub type Result<T> = std::result::Result<T, OdometryError>;

@@ -1,0 +1,253 @@
+//! The seed's elaborated SAD block matching (SPEC 6.2).
+//!
+//! The central `region` x `region` pixels of a frame are cut into `window` x `window` search
+//! windows (400 for the defaults). In each, the `block` x `block` block at the window's centre
+//! in frame n-1 is compared by the sum of absolute differences with every position it can
+//! take inside the window in frame n; the best position gives the window's flow (integer
+//! pixels, up to +-(window - block) / 2). Border windows are dropped (18 x 18 = 324 remain),
+//! the rest are grouped `group` x `group` (36 groups); in each group the flows farther than
+//! `outlier_px` from the group's median are rejected and the rest averaged: one flow vector
+//! per group, at the mean position of its blocks.
+//!
+//! A window whose candidates all cost the same (a flat floor) has no flow; a frame where no
+//! group keeps a flow is reported as [`OdometryError::NoTexture`].
+
+use crate::{OdometryError, Result};
+use ocellus_image::simd::Madd;
+use ocellus_image::{dispatch_kernel, Backend, Plane};
+
+/// Parameters of the flow measurement (the seed's defaults).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SadFlowConfig {
+    /// Side of the central region searched, pixels.
+    pub region: usize,
+    /// Side of a search window, pixels.
+    pub window: usize,
+    /// Side of the matched block, pixels.
+    pub block: usize,
+    /// Windows per group side.
+    pub group: usize,
+    /// Flows farther than this from their group's median (per axis) are outliers, pixels.
+    pub outlier_px: f64,
+}
+
+impl Default for SadFlowConfig {
+    /// 400x400 region, 20x20 windows, 8x8 blocks, 3x3 groups, outliers beyond 1 px.
+    fn default() -> Self {
+        Self { region: 400, window: 20, block: 8, group: 3, outlier_px: 1.0 }
+    }
+}
+
+impl SadFlowConfig {
+    fn check(&self, w: usize, h: usize) -> Result<usize> {
+        if self.block == 0 || self.block >= self.window || (self.window - self.block) % 2 != 0 {
+            return Err(OdometryError::Invalid(format!(
+                "block {} in window {}: the block must be smaller, with an even margin",
+                self.block, self.window
+            )));
+        }
+        let n = self.region / self.window;
+        if self.region % self.window != 0 || n < 2 + self.group || (n - 2) % self.group != 0 {
+            return Err(OdometryError::Invalid(format!(
+                "region {} in windows of {}: need a whole number of windows, and after dropping the border a multiple of {} per side",
+                self.region, self.window, self.group
+            )));
+        }
+        if !(self.outlier_px.is_finite() && self.outlier_px >= 0.0) {
+            return Err(OdometryError::Invalid(format!("outlier threshold {}", self.outlier_px)));
+        }
+        if w < self.region || h < self.region {
+            return Err(OdometryError::FrameSize {
+                got_w: w,
+                got_h: h,
+                why: format!("the central region is {0}x{0}", self.region),
+            });
+        }
+        Ok(n)
+    }
+}
+
+/// One window's measurement.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindowFlow {
+    /// Centre of the block in frame n-1, pixels (image coordinates).
+    pub x: f64,
+    /// Centre of the block in frame n-1, pixels.
+    pub y: f64,
+    /// Flow, pixels (`None` when every position costs the same).
+    pub flow: Option<(i32, i32)>,
+}
+
+/// One group's flow vector.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlowPoint {
+    /// Position relative to the principal point ((w - 1) / 2, (h - 1) / 2), pixels, x right.
+    pub u: f64,
+    /// Position relative to the principal point, pixels, y down.
+    pub v: f64,
+    /// Flow along x, pixels per frame.
+    pub du: f64,
+    /// Flow along y, pixels per frame.
+    pub dv: f64,
+    /// Windows averaged (after outlier rejection).
+    pub inliers: usize,
+}
+
+#[inline(always)]
+// The dispatch macro instantiates kernels per multiply-add flavour; integer kernels ignore it.
+#[allow(clippy::extra_unused_type_parameters)]
+fn windows_generic<M: Madd>(
+    prev: &Plane<u8>,
+    cur: &Plane<u8>,
+    cfg: &SadFlowConfig,
+    n: usize,
+    out: &mut Vec<WindowFlow>,
+) {
+    let (w, h) = prev.size();
+    let (x0, y0) = ((w - cfg.region) / 2, (h - cfg.region) / 2);
+    let (b, m) = (cfg.block, (cfg.window - cfg.block) / 2);
+    let span = 2 * m + 1;
+    out.clear();
+    for j in 0..n {
+        for i in 0..n {
+            let (wx, wy) = (x0 + i * cfg.window, y0 + j * cfg.window);
+            let (bx, by) = (wx + m, wy + m);
+            let (mut best, mut worst, mut at) = (u32::MAX, 0u32, (0usize, 0usize));
+            for oy in 0..span {
+                for ox in 0..span {
+                    let mut sad = 0u32;
+                    for r in 0..b {
+                        let a = &prev.row(by + r)[bx..bx + b];
+                        let c = &cur.row(wy + oy + r)[wx + ox..wx + ox + b];
+                        sad += a.iter().zip(c).map(|(p, q)| p.abs_diff(*q) as u32).sum::<u32>();
+                    }
+                    if sad < best {
+                        best = sad;
+                        at = (ox, oy);
+                    }
+                    worst = worst.max(sad);
+                }
+            }
+            let flow = (worst > best).then(|| (at.0 as i32 - m as i32, at.1 as i32 - m as i32));
+            out.push(WindowFlow { x: bx as f64 + (b as f64 - 1.0) / 2.0, y: by as f64 + (b as f64 - 1.0) / 2.0, flow });
+        }
+    }
+}
+
+dispatch_kernel!(fn windows_kernel => windows_generic(
+    prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig, n: usize, out: &mut Vec<WindowFlow>
+));
+
+/// Every window's flow between `prev` and `cur`, row by row (window rows of the region).
+pub fn window_flows(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig) -> Result<Vec<WindowFlow>> {
+    if prev.size() != cur.size() {
+        return Err(OdometryError::FrameSize {
+            got_w: cur.width(),
+            got_h: cur.height(),
+            why: format!("the previous frame is {}x{}", prev.width(), prev.height()),
+        });
+    }
+    let n = cfg.check(prev.width(), prev.height())?;
+    let mut out = Vec::with_capacity(n * n);
+    windows_kernel(Backend::Auto, prev, cur, cfg, n, &mut out);
+    Ok(out)
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let k = v.len() / 2;
+    if v.len() % 2 == 1 {
+        v[k]
+    } else {
+        0.5 * (v[k - 1] + v[k])
+    }
+}
+
+/// The seed's 36 group flows: border windows dropped, groups of `group` x `group`, outliers
+/// beyond `outlier_px` of the group median rejected, the rest averaged. Groups without a
+/// flow are left out; no flow at all is [`OdometryError::NoTexture`].
+pub fn group_flows(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig) -> Result<Vec<FlowPoint>> {
+    let windows = window_flows(prev, cur, cfg)?;
+    let n = cfg.region / cfg.window;
+    let (cx, cy) = ((prev.width() as f64 - 1.0) / 2.0, (prev.height() as f64 - 1.0) / 2.0);
+    let groups = (n - 2) / cfg.group;
+    let mut out = Vec::with_capacity(groups * groups);
+    let (mut xs, mut ys) = (Vec::new(), Vec::new());
+    for gj in 0..groups {
+        for gi in 0..groups {
+            let members: Vec<&WindowFlow> = (0..cfg.group)
+                .flat_map(|dj| (0..cfg.group).map(move |di| (1 + gi * cfg.group + di, 1 + gj * cfg.group + dj)))
+                .map(|(i, j)| &windows[j * n + i])
+                .collect();
+            xs.clear();
+            ys.clear();
+            for m in &members {
+                if let Some((fx, fy)) = m.flow {
+                    xs.push(fx as f64);
+                    ys.push(fy as f64);
+                }
+            }
+            if xs.is_empty() {
+                continue;
+            }
+            let (mx, my) = (median(&mut xs.clone()), median(&mut ys.clone()));
+            let (mut sx, mut sy, mut su, mut sv, mut k) = (0.0, 0.0, 0.0, 0.0, 0usize);
+            for m in &members {
+                if let Some((fx, fy)) = m.flow {
+                    if (fx as f64 - mx).abs() <= cfg.outlier_px && (fy as f64 - my).abs() <= cfg.outlier_px {
+                        sx += fx as f64;
+                        sy += fy as f64;
+                        su += m.x;
+                        sv += m.y;
+                        k += 1;
+                    }
+                }
+            }
+            if k > 0 {
+                let kf = k as f64;
+                out.push(FlowPoint { u: su / kf - cx, v: sv / kf - cy, du: sx / kf, dv: sy / kf, inliers: k });
+            }
+        }
+    }
+    if out.is_empty() {
+        return Err(OdometryError::NoTexture("no search window found a unique best match".into()));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ocellus_image::rng::SplitMix64;
+
+    fn texture(w: usize, h: usize, seed: u64) -> Plane<u8> {
+        let mut rng = SplitMix64::new(seed);
+        Plane::from_fn(w, h, |_, _| (rng.next_u64() & 255) as u8)
+    }
+
+    #[test]
+    fn a_shifted_frame_gives_its_shift_everywhere() {
+        let big = texture(700, 540, 1);
+        let prev = Plane::from_fn(640, 480, |x, y| big.get(x + 30, y + 30));
+        // The floor moves by (+3, -2) pixels in the image.
+        let cur = Plane::from_fn(640, 480, |x, y| big.get(x + 30 - 3, y + 30 + 2));
+        let g = group_flows(&prev, &cur, &SadFlowConfig::default()).unwrap();
+        assert_eq!(g.len(), 36);
+        for p in &g {
+            assert_eq!((p.du, p.dv, p.inliers), (3.0, -2.0, 9));
+        }
+        // Group centres cover the region symmetrically around the principal point.
+        let (su, sv): (f64, f64) = g.iter().fold((0.0, 0.0), |a, p| (a.0 + p.u, a.1 + p.v));
+        assert!(su.abs() < 1e-9 && sv.abs() < 1e-9, "{su} {sv}");
+    }
+
+    #[test]
+    fn a_flat_floor_is_reported_and_bad_sizes_are_errors() {
+        let flat = Plane::from_fn(640, 480, |_, _| 90u8);
+        assert!(matches!(group_flows(&flat, &flat, &SadFlowConfig::default()), Err(OdometryError::NoTexture(_))));
+        let small = Plane::new(320, 240);
+        assert!(group_flows(&small, &small, &SadFlowConfig::default()).is_err());
+        assert!(group_flows(&flat, &small, &SadFlowConfig::default()).is_err());
+        assert!(group_flows(&flat, &flat, &SadFlowConfig { window: 21, ..Default::default() }).is_err());
+    }
+}

@@ -1,0 +1,155 @@
+//! The seed's visual odometry (SPEC 6.3): a Kalman filter on the camera motion per frame.
+//!
+//! State `(Tx, Ty, wz)`: the camera's translation over one frame in the image axes (metres)
+//! and its rotation (radians), a random walk. Measurement: the 36 group flows, 72 numbers,
+//! with the simplified image Jacobian of each point (u, v) (relative to the principal point):
+//! `du = (f/z) Tx - v wz`, `dv = (f/z) Ty + u wz` (f focal length in pixels, z camera height).
+//! With 72 measurements and 3 states the update is done in information form: the 3x3
+//! information matrix gains `sum H^T H / sigma^2`, which is exact and avoids inverting the
+//! 72x72 innovation covariance.
+//!
+//! The floor moving by (du, dv) in the image means the camera moved by `-du` to the right and
+//! `+dv` forward (image y points backwards), and turned by `-wz` (clockwise positive); the
+//! robot's motion follows with the mount offset ([`crate::kinematics::robot_motion`]).
+
+use crate::kinematics::{robot_motion, Mount, Pose2};
+use crate::sad_flow::{group_flows, FlowPoint, SadFlowConfig};
+use crate::{OdometryError, Result};
+use nalgebra::{Matrix3, Vector3};
+use ocellus_image::Plane;
+
+/// Configuration of [`VisualOdometry`].
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct OdometryConfig {
+    /// Camera height above the floor, metres.
+    pub height_m: f64,
+    /// Focal length, pixels.
+    pub focal_px: f64,
+    /// Camera position relative to the robot's rotation centre.
+    pub mount: Mount,
+    /// The flow measurement.
+    pub flow: SadFlowConfig,
+    /// Random-walk standard deviation per frame of Tx, Ty (metres) and wz (radians).
+    pub process_sigma: [f64; 3],
+    /// Standard deviation of one flow component, pixels.
+    pub flow_sigma_px: f64,
+}
+
+impl OdometryConfig {
+    /// The seed's method for a camera `height_m` above the floor with focal length
+    /// `focal_px`, mounted at `mount`.
+    pub fn seed(height_m: f64, focal_px: f64, mount: Mount) -> Self {
+        let px_m = height_m / focal_px;
+        Self {
+            height_m,
+            focal_px,
+            mount,
+            flow: SadFlowConfig::default(),
+            // Speed changes of about 0.5 px and 0.1 degree per frame.
+            process_sigma: [0.5 * px_m, 0.5 * px_m, 0.1f64.to_radians()],
+            flow_sigma_px: 0.5,
+        }
+    }
+
+    fn check(&self) -> Result<()> {
+        let ok = self.height_m > 0.0
+            && self.focal_px > 0.0
+            && self.height_m.is_finite()
+            && self.focal_px.is_finite()
+            && self.flow_sigma_px > 0.0
+            && self.flow_sigma_px.is_finite()
+            && self.process_sigma.iter().all(|s| *s > 0.0 && s.is_finite())
+            && self.mount.right_m.is_finite()
+            && self.mount.forward_m.is_finite();
+        if ok {
+            Ok(())
+        } else {
+            Err(OdometryError::Invalid(format!(
+                "height {} m, focal {} px, flow sigma {} px, process sigma {:?}, mount {:?}: all finite and positive",
+                self.height_m, self.focal_px, self.flow_sigma_px, self.process_sigma, self.mount
+            )))
+        }
+    }
+}
+
+/// What one frame gave.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OdometryStep {
+    /// The robot's pose after this frame.
+    pub pose: Pose2,
+    /// The filtered camera motion of this frame: right (m), forward (m), turn (rad).
+    pub camera_motion: [f64; 3],
+    /// The flow vectors measured (empty for the first frame and on failure).
+    pub flows: Vec<FlowPoint>,
+    /// Why no measurement was used (the motion was then predicted), if so.
+    pub failure: Option<String>,
+}
+
+/// The seed's visual odometry over a frame stream.
+#[derive(Clone, Debug)]
+pub struct VisualOdometry {
+    cfg: OdometryConfig,
+    prev: Option<Plane<u8>>,
+    x: Vector3<f64>,
+    p: Matrix3<f64>,
+    pose: Pose2,
+}
+
+impl VisualOdometry {
+    /// A filter at rest at the origin.
+    pub fn new(cfg: OdometryConfig) -> Result<Self> {
+        cfg.check()?;
+        let px_m = cfg.height_m / cfg.focal_px;
+        // Initially unsure by a few pixels per frame and a degree per frame.
+        let p = Matrix3::from_diagonal(&Vector3::new(
+            (5.0 * px_m).powi(2),
+            (5.0 * px_m).powi(2),
+            1f64.to_radians().powi(2),
+        ));
+        Ok(Self { cfg, prev: None, x: Vector3::zeros(), p, pose: Pose2::default() })
+    }
+
+    /// The current pose.
+    pub fn pose(&self) -> Pose2 {
+        self.pose
+    }
+
+    /// Processes the next frame (grey, the same size as the previous ones).
+    pub fn step(&mut self, frame: &Plane<u8>) -> Result<OdometryStep> {
+        let Some(prev) = self.prev.replace(frame.clone()) else {
+            return Ok(OdometryStep { pose: self.pose, camera_motion: [0.0; 3], flows: Vec::new(), failure: None });
+        };
+        let s = self.cfg.process_sigma;
+        let mut p_pred = self.p + Matrix3::from_diagonal(&Vector3::new(s[0] * s[0], s[1] * s[1], s[2] * s[2]));
+        let (flows, failure) = match group_flows(&prev, frame, &self.cfg.flow) {
+            Ok(f) => (f, None),
+            Err(OdometryError::NoTexture(why)) => (Vec::new(), Some(why)),
+            Err(e) => return Err(e),
+        };
+        if !flows.is_empty() {
+            let k = self.cfg.focal_px / self.cfg.height_m;
+            let w = 1.0 / (self.cfg.flow_sigma_px * self.cfg.flow_sigma_px);
+            let info_prior = p_pred.try_inverse().unwrap_or_else(Matrix3::zeros);
+            let mut info = info_prior;
+            let mut vec = info_prior * self.x;
+            for f in &flows {
+                let h1 = Vector3::new(k, 0.0, -f.v);
+                let h2 = Vector3::new(0.0, k, f.u);
+                info += (h1 * h1.transpose() + h2 * h2.transpose()) * w;
+                vec += (h1 * f.du + h2 * f.dv) * w;
+            }
+            match info.try_inverse() {
+                Some(cov) => {
+                    self.x = cov * vec;
+                    p_pred = cov;
+                }
+                None => return Err(OdometryError::NoTexture("the flow does not determine the motion".into())),
+            }
+        }
+        self.p = p_pred;
+        let (cam_right, cam_forward, turn) = (-self.x[0], self.x[1], -self.x[2]);
+        let (r, f, t) = robot_motion(cam_right, cam_forward, turn, &self.cfg.mount);
+        self.pose = self.pose.step(r, f, t);
+        Ok(OdometryStep { pose: self.pose, camera_motion: [cam_right, cam_forward, turn], flows, failure })
+    }
+}

@@ -1,0 +1,101 @@
+//! The seed's visual odometry on generated ground sequences built from the real textures.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use ocellus_image::Plane;
+use ocellus_odometry::kinematics::Mount;
+use ocellus_odometry::vo::{OdometryConfig, VisualOdometry};
+use ocellus_synth::ground::{GroundConfig, GroundScene, GroundTexture};
+
+fn textures() -> [Plane<f32>; 3] {
+    ["brick.png", "grass.png", "gravel.png"]
+        .map(|n| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap().to_luma8().map(|v| v as f32))
+}
+
+/// Runs the seed odometry over a scene: (final drift in % of the path, final heading error in
+/// degrees).
+fn run(scene: &GroundScene) -> (f64, f64) {
+    let c = scene.config();
+    // 1 ground pixel = 0.5 mm: a camera 0.3 m up with a 600 px focal length.
+    let cfg = OdometryConfig::seed(
+        0.3,
+        600.0,
+        Mount { right_m: c.mount_px[0] * c.metres_per_px, forward_m: c.mount_px[1] * c.metres_per_px },
+    );
+    let mut vo = VisualOdometry::new(cfg).unwrap();
+    let mut path = 0.0;
+    let mut last = scene.pose_m(0).unwrap();
+    for k in 0..scene.len() {
+        vo.step(&scene.frame(k).unwrap()).unwrap();
+        let p = scene.pose_m(k).unwrap();
+        path += ((p.0 - last.0).powi(2) + (p.1 - last.1).powi(2)).sqrt();
+        last = p;
+    }
+    let est = vo.pose();
+    let err = ((est.x - last.0).powi(2) + (est.y - last.1).powi(2)).sqrt();
+    let drift = if path > 0.0 { 100.0 * err / path } else { err };
+    (drift, (est.theta - last.2).to_degrees().abs())
+}
+
+#[test]
+fn seed_mode_tracks_grass_and_brick() {
+    let t = textures();
+    // Integer flows drift: the seed reports about 0.5 % on grass and gravel and 4.5 % on brick,
+    // whose mortar lines make windows slide along them. The bounds catch a broken filter or
+    // sign (hundreds of percent), not the method's own error.
+    for (texture, bound) in [(GroundTexture::Grass, 4.0), (GroundTexture::Brick, 25.0)] {
+        let cfg = GroundConfig { frames: 120, ..GroundConfig::easy(texture, 1) };
+        let (drift, heading) = run(&GroundScene::new(cfg, t.clone()).unwrap());
+        println!("seed mode, {texture:?}, 120 frames: drift {drift:.3} % of the path, heading error {heading:.3} deg");
+        assert!(drift < bound && heading < 2.0, "{texture:?}: drift {drift} %, heading {heading} deg");
+    }
+}
+
+#[test]
+fn standing_still_gives_no_motion_and_turning_in_place_the_right_heading() {
+    let t = textures();
+    let still = GroundConfig {
+        frames: 20,
+        forward_px: 0.0,
+        forward_spread_px: 0.0,
+        lateral_px: 0.0,
+        yaw_deg: 0.0,
+        yaw_spread_deg: 0.0,
+        ..GroundConfig::easy(GroundTexture::Gravel, 2)
+    };
+    let s = GroundScene::new(still, t.clone()).unwrap();
+    let cfg = OdometryConfig::seed(0.3, 600.0, Mount { right_m: 0.0, forward_m: 0.05 });
+    let mut vo = VisualOdometry::new(cfg).unwrap();
+    for k in 0..s.len() {
+        vo.step(&s.frame(k).unwrap()).unwrap();
+    }
+    let p = vo.pose();
+    assert!(p.x.abs() < 1e-9 && p.y.abs() < 1e-9 && p.theta.abs() < 1e-9, "{p:?}");
+    // Turning in place by 0.3 degrees per frame about the rotation centre (camera 5 cm
+    // ahead, so the image both turns and slides).
+    let turn = GroundConfig { yaw_deg: 0.3, frames: 40, ..still };
+    let s = GroundScene::new(turn, t.clone()).unwrap();
+    let mut vo = VisualOdometry::new(cfg).unwrap();
+    for k in 0..s.len() {
+        vo.step(&s.frame(k).unwrap()).unwrap();
+    }
+    let (p, truth) = (vo.pose(), s.pose_m(s.len() - 1).unwrap());
+    println!(
+        "turn in place: heading {:.3} deg (truth {:.3}), position ({:.2}, {:.2}) mm",
+        p.theta.to_degrees(),
+        truth.2.to_degrees(),
+        p.x * 1e3,
+        p.y * 1e3
+    );
+    assert!((p.theta - truth.2).abs().to_degrees() < 0.5);
+    assert!(p.x.hypot(p.y) < 0.005, "the rotation centre stays put: {p:?}");
+}
+
+#[test]
+fn a_blank_floor_is_a_reported_failure() {
+    let flat = Plane::from_fn(640, 480, |_, _| 120u8);
+    let mut vo = VisualOdometry::new(OdometryConfig::seed(0.3, 600.0, Mount::default())).unwrap();
+    vo.step(&flat).unwrap();
+    let s = vo.step(&flat).unwrap();
+    assert!(s.failure.is_some() && s.flows.is_empty());
+    assert!(vo.step(&Plane::new(100, 100)).is_err());
+}
