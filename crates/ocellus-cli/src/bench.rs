@@ -19,8 +19,10 @@ pub enum Target {
     Attention,
     /// One view-direction decision: 19 candidate pans, a 40x30 surprise map (microseconds).
     Planning,
-    /// DLT from 100 points, triangulation of 100k points, block matching at 741x500.
+    /// DLT and Zhang calibration, triangulation of 100k points, block matching and SGM at 741x500.
     Geometry,
+    /// Visual odometry per 640x480 frame on one core (seed mode), on generated floor frames.
+    Odometry,
 }
 
 /// Arguments of `ocellus bench`.
@@ -176,6 +178,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         Target::Attention => return crate::bench_attention::run(a.json, a.frames),
         Target::Planning => return crate::bench_planning::run(a.json, a.frames.max(100)),
         Target::Geometry => return crate::bench_geometry::run(a.json, 5),
+        Target::Odometry => return crate::bench_odometry::run(a.json),
         Target::Saliency => {}
     }
     let backend: Backend = serde_json::from_value(json!(a.backend))

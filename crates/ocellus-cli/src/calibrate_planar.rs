@@ -211,8 +211,14 @@ fn report(
     source: &str,
     square_mm: f64,
 ) -> Result<()> {
-    let cam =
-        CameraFile { image_size: size.map(|s| [s.0, s.1]), intrinsics: cal.intrinsics, distortion: cal.distortion };
+    let cam = CameraFile {
+        image_size: size.map(|s| [s.0, s.1]),
+        intrinsics: cal.intrinsics,
+        distortion: cal.distortion,
+        height_m: None,
+        mount_right_m: None,
+        mount_forward_m: None,
+    };
     camera_file::write(&out.join("camera.toml"), &cam)?;
     let sd = &cal.std_dev;
     let views: Vec<_> = names

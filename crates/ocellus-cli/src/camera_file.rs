@@ -18,6 +18,15 @@ pub struct CameraFile {
     /// Lens distortion (zero when absent).
     #[serde(default)]
     pub distortion: Distortion,
+    /// Height of the camera above the floor, metres (ground-facing cameras, odometry).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height_m: Option<f64>,
+    /// Camera position to the right of the robot's rotation centre, metres (odometry).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mount_right_m: Option<f64>,
+    /// Camera position ahead of the robot's rotation centre, metres (odometry).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mount_forward_m: Option<f64>,
 }
 
 fn is_toml(path: &Path) -> bool {

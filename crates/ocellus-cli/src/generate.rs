@@ -24,6 +24,9 @@ enum What {
     /// Views of a chessboard over a real photo, rendered through a known distorted camera, with
     /// the true camera and corner positions (try `ocellus calibrate chessboard` on them).
     Chessboard(crate::generate_chessboard::ChessboardArgs),
+    /// A camera looking down at a floor of real textures (brick, grass, gravel, mosaic) with
+    /// known planar motion at 200 Hz: frames, TUM ground truth, wheel encoders (odometry).
+    Ground(crate::generate_ground::GroundArgs),
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -81,6 +84,7 @@ pub fn run(a: GenerateArgs) -> Result<()> {
     let a = match a.what {
         What::Attention(a) => a,
         What::Chessboard(a) => return crate::generate_chessboard::run(a),
+        What::Ground(a) => return crate::generate_ground::run(a),
     };
     let scenario = match a.scenario {
         ScenarioArg::Static => Scenario::Static,

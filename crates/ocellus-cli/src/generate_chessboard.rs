@@ -55,6 +55,9 @@ pub fn run(a: ChessboardArgs) -> Result<()> {
             image_size: Some([640, 480]),
             intrinsics: Intrinsics { fx: 640.0, fy: 636.0, cx: 324.0, cy: 236.0, skew: 0.0 },
             distortion: Distortion { k1: -0.22, k2: 0.06, k3: 0.0, p1: 0.0008, p2: -0.0005 },
+            height_m: None,
+            mount_right_m: None,
+            mount_forward_m: None,
         },
     };
     let [w, h] = truth.image_size.context("the camera file needs image_size = [width, height] to render")?;

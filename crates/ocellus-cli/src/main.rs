@@ -5,6 +5,7 @@ mod attend;
 mod bench;
 mod bench_attention;
 mod bench_geometry;
+mod bench_odometry;
 mod bench_planning;
 mod calibrate_cmd;
 mod calibrate_planar;
@@ -16,7 +17,9 @@ mod eval;
 mod frames;
 mod generate;
 mod generate_chessboard;
+mod generate_ground;
 mod inputs;
+mod odometry_cmd;
 mod overlay;
 mod plan_cmd;
 mod plot;
@@ -65,6 +68,10 @@ enum Command {
     /// `chessboard` from images of a chessboard and `planar` from planar correspondences
     /// (Zhang with lens distortion; camera.toml, standard deviations, per-view errors).
     Calibrate(calibrate_cmd::CalibrateArgs),
+    /// Visual odometry of a camera looking down at the floor (the seed's block matching and
+    /// Kalman filter): a TUM trajectory, a plot and flow overlays; `odometry eval` scores a
+    /// trajectory against ground truth.
+    Odometry(odometry_cmd::OdometryArgs),
     /// Remove lens distortion from images with a calibrated camera file (same intrinsics).
     Undistort(undistort_cmd::UndistortArgs),
     /// 3D points from pixel matches in two or more calibrated cameras (camera JSON files of
@@ -73,7 +80,9 @@ enum Command {
     /// Dense disparity of a rectified stereo pair by semi-global matching or block matching;
     /// depth and a point cloud with calibration; bad-2.0 against a ground-truth PFM.
     Stereo(stereo_cmd::StereoArgs),
-    /// Generate ground-truth sequences from the built-in real images.
+    /// Generate ground-truth scenes and sequences from the built-in real images (`synth` is
+    /// the same command).
+    #[command(visible_alias = "synth")]
     Generate(generate::GenerateArgs),
     /// Print benchmark figures (median ms per frame, fps on all cores, per stage, peak memory).
     Bench(bench::BenchArgs),
@@ -101,6 +110,7 @@ fn main() {
         Command::Calibrate(a) => calibrate_cmd::run(a),
         Command::Triangulate(a) => triangulate_cmd::run(a),
         Command::Undistort(a) => undistort_cmd::run(a),
+        Command::Odometry(a) => odometry_cmd::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

@@ -1,0 +1,83 @@
+//! `ocellus synth ground`, `ocellus odometry` and `ocellus odometry eval` as a user runs them.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn ocellus() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_ocellus"))
+}
+
+fn tmpdir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ocellus-odo-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn run(cmd: &mut Command) -> String {
+    let o = cmd.output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+#[test]
+fn generate_estimate_and_evaluate_a_ground_sequence() {
+    let dir = tmpdir("run");
+    let seq = dir.join("seq");
+    run(ocellus().args(["synth", "ground", "--texture", "gravel", "--frames", "40", "--y4m", "--out"]).arg(&seq));
+    for f in ["sequence.y4m", "groundtruth.tum", "encoders.csv", "camera.toml"] {
+        assert!(seq.join(f).is_file(), "{f}");
+    }
+    let out = dir.join("odo");
+    let s = run(ocellus()
+        .arg("odometry")
+        .arg(seq.join("sequence.y4m"))
+        .arg("--camera")
+        .arg(seq.join("camera.toml"))
+        .arg("--out")
+        .arg(&out));
+    assert!(s.contains("40 frames"), "{s}");
+    assert!(out.join("trajectory.png").is_file() && out.join("flow_00001.png").is_file());
+    let est = ocellus_io::tum::read(out.join("trajectory.tum")).unwrap();
+    assert_eq!(est.len(), 40);
+    let e = run(ocellus()
+        .args(["odometry", "eval"])
+        .arg(out.join("trajectory.tum"))
+        .arg(seq.join("groundtruth.tum"))
+        .arg("--plot")
+        .arg(dir.join("p.png")));
+    let drift: f64 = e.split("final drift ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap();
+    // Seed mode on gravel over 40 frames: a few percent at most (a broken sign or scale
+    // gives tens or hundreds).
+    assert!(drift < 10.0, "{e}");
+    assert!(dir.join("p.png").is_file());
+    // The ground truth against itself: no error at all.
+    let z = run(ocellus()
+        .args(["odometry", "eval"])
+        .arg(seq.join("groundtruth.tum"))
+        .arg(seq.join("groundtruth.tum"))
+        .arg("--plot")
+        .arg(dir.join("z.png")));
+    assert!(z.contains("final drift 0.0000 %") && z.contains("ATE RMSE 0.000 mm"), "{z}");
+}
+
+#[test]
+fn odometry_errors_are_clear() {
+    let dir = tmpdir("err");
+    std::fs::write(dir.join("a.tum"), "0 0 0 0 0 0 0 1\n0.005 0 0 0 0 0 0 1\n").unwrap();
+    std::fs::write(dir.join("b.tum"), "10 0 0 0 0 0 0 1\n10.005 0 0 0 0 0 0 1\n").unwrap();
+    let o = ocellus().args(["odometry", "eval"]).arg(dir.join("a.tum")).arg(dir.join("b.tum")).output().unwrap();
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("pair up"));
+    let o = ocellus().arg("odometry").arg(dir.join("missing")).output().unwrap();
+    assert!(!o.status.success());
+    std::fs::write(dir.join("cam.toml"), "[intrinsics]\nfx = 600.0\nfy = 600.0\ncx = 319.5\ncy = 239.5\nskew = 0.0\n")
+        .unwrap();
+    let o =
+        ocellus().arg("odometry").arg(dir.join("a.tum")).arg("--camera").arg(dir.join("cam.toml")).output().unwrap();
+    assert!(
+        !o.status.success() && String::from_utf8_lossy(&o.stderr).contains("height"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
