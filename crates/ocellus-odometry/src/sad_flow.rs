@@ -93,6 +93,101 @@ pub struct FlowPoint {
     pub inliers: usize,
 }
 
+/// Best offset (first in raster order on ties) and whether the costs differ at all, for the
+/// block at (bx, by) searched over offsets 0..span (x and y) from (wx, wy).
+#[inline(always)]
+fn search_scalar(
+    prev: &Plane<u8>,
+    cur: &Plane<u8>,
+    b: usize,
+    bx: usize,
+    by: usize,
+    wx: usize,
+    wy: usize,
+    span: usize,
+) -> Option<(usize, usize)> {
+    let (mut best, mut worst, mut at) = (u32::MAX, 0u32, (0usize, 0usize));
+    for oy in 0..span {
+        for ox in 0..span {
+            let mut sad = 0u32;
+            for r in 0..b {
+                let a = &prev.row(by + r)[bx..bx + b];
+                let c = &cur.row(wy + oy + r)[wx + ox..wx + ox + b];
+                sad += a.iter().zip(c).map(|(p, q)| p.abs_diff(*q) as u32).sum::<u32>();
+            }
+            if sad < best {
+                best = sad;
+                at = (ox, oy);
+            }
+            worst = worst.max(sad);
+        }
+    }
+    (worst > best).then_some(at)
+}
+
+/// [`search_scalar`] for 8x8 blocks and up to 16 offsets per axis with SSE4.1's `mpsadbw`
+/// (eight 4-byte SADs at consecutive offsets per instruction) and `phminposuw`.
+///
+/// # Safety
+/// The CPU must support SSE4.1; the rows `wy..wy + span + 7` of `cur` must have 32 bytes
+/// from `wx`, and the block must lie inside `prev`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "sse4.1")]
+unsafe fn search_8x8_sse41(
+    prev: &Plane<u8>,
+    cur: &Plane<u8>,
+    bx: usize,
+    by: usize,
+    wx: usize,
+    wy: usize,
+    span: usize,
+) -> Option<(usize, usize)> {
+    use std::arch::x86_64::*;
+    debug_assert!(span <= 16);
+    // SAFETY (whole body): the caller guarantees the feature and the bounds of every load.
+    unsafe {
+        let mut acc = [[_mm_setzero_si128(); 2]; 16];
+        for r in 0..8 {
+            let brow = _mm_loadl_epi64(prev.row(by + r)[bx..bx + 8].as_ptr() as *const __m128i);
+            for (oy, a) in acc.iter_mut().enumerate().take(span) {
+                let row = &cur.row(wy + oy + r)[wx..wx + 32];
+                let c0 = _mm_loadu_si128(row.as_ptr() as *const __m128i);
+                let c1 = _mm_loadu_si128(row[8..].as_ptr() as *const __m128i);
+                // Bytes 0-3 of the block against offsets 0..8, bytes 4-7 against 4..12.
+                a[0] = _mm_add_epi16(
+                    a[0],
+                    _mm_add_epi16(_mm_mpsadbw_epu8::<0b000>(c0, brow), _mm_mpsadbw_epu8::<0b101>(c0, brow)),
+                );
+                a[1] = _mm_add_epi16(
+                    a[1],
+                    _mm_add_epi16(_mm_mpsadbw_epu8::<0b000>(c1, brow), _mm_mpsadbw_epu8::<0b101>(c1, brow)),
+                );
+            }
+        }
+        // Offsets past `span` in the second half are masked to the maximum.
+        let lanes = _mm_setr_epi16(8, 9, 10, 11, 12, 13, 14, 15);
+        let outside = _mm_cmpgt_epi16(lanes, _mm_set1_epi16(span as i16 - 1));
+        let (mut best, mut at) = (u32::MAX, (0usize, 0usize));
+        let mut hi = _mm_setzero_si128();
+        for (oy, a) in acc.iter().enumerate().take(span) {
+            let halves = [a[0], _mm_or_si128(a[1], outside)];
+            for (h, v) in halves.iter().enumerate() {
+                let m = _mm_minpos_epu16(*v);
+                let val = _mm_extract_epi16::<0>(m) as u32;
+                if val < best {
+                    best = val;
+                    at = (8 * h + _mm_extract_epi16::<1>(m) as usize, oy);
+                }
+            }
+            hi = _mm_max_epu16(hi, a[0]);
+            hi = _mm_max_epu16(hi, _mm_andnot_si128(outside, a[1]));
+        }
+        // Flat: the largest cost equals the smallest.
+        let worst = 0xffff - _mm_extract_epi16::<0>(_mm_minpos_epu16(_mm_sub_epi16(_mm_set1_epi16(-1), hi))) as u32;
+        (worst > best).then_some(at)
+    }
+}
+
 #[inline(always)]
 // The dispatch macro instantiates kernels per multiply-add flavour; integer kernels ignore it.
 #[allow(clippy::extra_unused_type_parameters)]
@@ -107,28 +202,24 @@ fn windows_generic<M: Madd>(
     let (x0, y0) = ((w - cfg.region) / 2, (h - cfg.region) / 2);
     let (b, m) = (cfg.block, (cfg.window - cfg.block) / 2);
     let span = 2 * m + 1;
+    #[cfg(target_arch = "x86_64")]
+    let fast = b == 8 && span <= 16 && x0 + (n - 1) * cfg.window + 32 <= w && is_x86_feature_detected!("sse4.1");
     out.clear();
     for j in 0..n {
         for i in 0..n {
             let (wx, wy) = (x0 + i * cfg.window, y0 + j * cfg.window);
             let (bx, by) = (wx + m, wy + m);
-            let (mut best, mut worst, mut at) = (u32::MAX, 0u32, (0usize, 0usize));
-            for oy in 0..span {
-                for ox in 0..span {
-                    let mut sad = 0u32;
-                    for r in 0..b {
-                        let a = &prev.row(by + r)[bx..bx + b];
-                        let c = &cur.row(wy + oy + r)[wx + ox..wx + ox + b];
-                        sad += a.iter().zip(c).map(|(p, q)| p.abs_diff(*q) as u32).sum::<u32>();
-                    }
-                    if sad < best {
-                        best = sad;
-                        at = (ox, oy);
-                    }
-                    worst = worst.max(sad);
-                }
-            }
-            let flow = (worst > best).then(|| (at.0 as i32 - m as i32, at.1 as i32 - m as i32));
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: SSE4.1 detected; `fast` checked that 32 bytes from wx fit every row, and
+            // the window (rows wy..wy + span + 7) lies inside the region.
+            let at = if fast {
+                unsafe { search_8x8_sse41(prev, cur, bx, by, wx, wy, span) }
+            } else {
+                search_scalar(prev, cur, b, bx, by, wx, wy, span)
+            };
+            #[cfg(not(target_arch = "x86_64"))]
+            let at = search_scalar(prev, cur, b, bx, by, wx, wy, span);
+            let flow = at.map(|(ox, oy)| (ox as i32 - m as i32, oy as i32 - m as i32));
             out.push(WindowFlow { x: bx as f64 + (b as f64 - 1.0) / 2.0, y: by as f64 + (b as f64 - 1.0) / 2.0, flow });
         }
     }
@@ -239,6 +330,24 @@ mod tests {
         // Group centres cover the region symmetrically around the principal point.
         let (su, sv): (f64, f64) = g.iter().fold((0.0, 0.0), |a, p| (a.0 + p.u, a.1 + p.v));
         assert!(su.abs() < 1e-9 && sv.abs() < 1e-9, "{su} {sv}");
+    }
+
+    #[test]
+    fn sse41_search_matches_the_scalar_one() {
+        if !is_x86_feature_detected!("sse4.1") {
+            return;
+        }
+        let mut rng = SplitMix64::new(9);
+        for case in 0..300 {
+            // Low-contrast textures make ties common.
+            let levels = if case % 3 == 0 { 3 } else { 256 };
+            let prev = Plane::from_fn(64, 48, |_, _| rng.below(levels) as u8);
+            let cur = Plane::from_fn(64, 48, |_, _| rng.below(levels) as u8);
+            let fast = unsafe { search_8x8_sse41(&prev, &cur, 12, 10, 6, 4, 13) };
+            assert_eq!(fast, search_scalar(&prev, &cur, 8, 12, 10, 6, 4, 13), "case {case}");
+        }
+        let flat = Plane::from_fn(64, 48, |_, _| 7u8);
+        assert_eq!(unsafe { search_8x8_sse41(&flat, &flat, 12, 10, 6, 4, 13) }, None);
     }
 
     #[test]
