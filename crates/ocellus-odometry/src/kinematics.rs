@@ -31,6 +31,27 @@ impl Pose2 {
     }
 }
 
+impl Pose2 {
+    /// The robot pose after its camera moved by (`camera_right`, `camera_forward`) in the
+    /// robot frame of this pose and turned by `turn`, exactly: the camera position follows,
+    /// and the rotation centre is found back from the mount offset at the new heading.
+    pub fn moved_by_camera(&self, camera_right: f64, camera_forward: f64, turn: f64, mount: &Mount) -> Pose2 {
+        let (r, f) = self.axes();
+        let cam = [
+            self.x + mount.right_m * r[0] + mount.forward_m * f[0] + camera_right * r[0] + camera_forward * f[0],
+            self.y + mount.right_m * r[1] + mount.forward_m * f[1] + camera_right * r[1] + camera_forward * f[1],
+        ];
+        let theta = self.theta + turn;
+        let next = Pose2 { x: 0.0, y: 0.0, theta };
+        let (r2, f2) = next.axes();
+        Pose2 {
+            x: cam[0] - mount.right_m * r2[0] - mount.forward_m * f2[0],
+            y: cam[1] - mount.right_m * r2[1] - mount.forward_m * f2[1],
+            theta,
+        }
+    }
+}
+
 /// Where the camera sits relative to the rotation centre, metres (robot frame).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Mount {
@@ -61,5 +82,16 @@ mod tests {
         assert!(r.abs() < 1e-12 && f.abs() < 1e-12 && t == 0.01);
         let p = Pose2::default().step(1.0, 2.0, 0.5);
         assert_eq!((p.x, p.y, p.theta), (1.0, -2.0, 0.5));
+        // Exactly: turning in place by a large angle moves the camera on a circle.
+        let q = Pose2 { x: 1.0, y: 2.0, theta: 0.3 };
+        let turn = 1.2;
+        let t = Pose2 { x: 0.0, y: 0.0, theta: q.theta + turn };
+        let cam0 = [q.x + 0.2 * q.axes().1[0], q.y + 0.2 * q.axes().1[1]];
+        let cam1 = [q.x + 0.2 * t.axes().1[0], q.y + 0.2 * t.axes().1[1]];
+        // The camera displacement in the robot frame of q.
+        let (r, f) = q.axes();
+        let d = [cam1[0] - cam0[0], cam1[1] - cam0[1]];
+        let moved = q.moved_by_camera(d[0] * r[0] + d[1] * r[1], d[0] * f[0] + d[1] * f[1], turn, &m);
+        assert!((moved.x - q.x).abs() < 1e-12 && (moved.y - q.y).abs() < 1e-12 && (moved.theta - 1.5).abs() < 1e-12);
     }
 }

@@ -6,6 +6,8 @@
 //!   flow vectors.
 //! - [`kinematics`]: planar poses, and the camera-to-robot motion of seed eq. 20 (a camera
 //!   mounted off the rotation centre).
+//! - [`robust`]: beyond the seed: sub-pixel Lucas-Kanade refinement with per-window
+//!   uncertainty (the aperture problem), a robust fit of the exact rigid motion over all windows.
 //! - [`vo`]: the Kalman filter on the camera motion (Tx, Ty, wz) with the image-Jacobian
 //!   measurement model, in information form, and the integration to a robot trajectory.
 //!
@@ -21,6 +23,7 @@
 //! ```
 
 pub mod kinematics;
+pub mod robust;
 pub mod sad_flow;
 pub mod vo;
 

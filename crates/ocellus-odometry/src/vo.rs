@@ -13,10 +13,21 @@
 //! robot's motion follows with the mount offset ([`crate::kinematics::robot_motion`]).
 
 use crate::kinematics::{robot_motion, Mount, Pose2};
+use crate::robust::{fit_rigid, window_measurements, RobustConfig};
 use crate::sad_flow::{group_flows, FlowPoint, SadFlowConfig};
 use crate::{OdometryError, Result};
 use nalgebra::{Matrix3, Vector3};
 use ocellus_image::Plane;
+
+/// Which estimator.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Mode {
+    /// The seed's method: integer SAD, 36 group flows, first-order model and kinematics.
+    Seed,
+    /// Sub-pixel flow with per-window uncertainty, a robust fit over all windows with the
+    /// exact rigid model, exact kinematics ([`crate::robust`]).
+    Robust,
+}
 
 /// Configuration of [`VisualOdometry`].
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -31,8 +42,12 @@ pub struct OdometryConfig {
     pub flow: SadFlowConfig,
     /// Random-walk standard deviation per frame of Tx, Ty (metres) and wz (radians).
     pub process_sigma: [f64; 3],
-    /// Standard deviation of one flow component, pixels.
+    /// Standard deviation of one flow component, pixels (seed mode).
     pub flow_sigma_px: f64,
+    /// Which estimator.
+    pub mode: Mode,
+    /// Robust-mode parameters.
+    pub robust: RobustConfig,
 }
 
 impl OdometryConfig {
@@ -48,7 +63,14 @@ impl OdometryConfig {
             // Speed changes of about 0.5 px and 0.1 degree per frame.
             process_sigma: [0.5 * px_m, 0.5 * px_m, 0.1f64.to_radians()],
             flow_sigma_px: 0.5,
+            mode: Mode::Seed,
+            robust: RobustConfig::default(),
         }
+    }
+
+    /// The robust mode for the same camera (see [`crate::robust`]).
+    pub fn robust(height_m: f64, focal_px: f64, mount: Mount) -> Self {
+        Self { mode: Mode::Robust, ..Self::seed(height_m, focal_px, mount) }
     }
 
     fn check(&self) -> Result<()> {
@@ -119,6 +141,9 @@ impl VisualOdometry {
         let Some(prev) = self.prev.replace(frame.clone()) else {
             return Ok(OdometryStep { pose: self.pose, camera_motion: [0.0; 3], flows: Vec::new(), failure: None });
         };
+        if self.cfg.mode == Mode::Robust {
+            return self.step_robust(&prev, frame);
+        }
         let s = self.cfg.process_sigma;
         let mut p_pred = self.p + Matrix3::from_diagonal(&Vector3::new(s[0] * s[0], s[1] * s[1], s[2] * s[2]));
         let (flows, failure) = match group_flows(&prev, frame, &self.cfg.flow) {
@@ -150,6 +175,37 @@ impl VisualOdometry {
         let (cam_right, cam_forward, turn) = (-self.x[0], self.x[1], -self.x[2]);
         let (r, f, t) = robot_motion(cam_right, cam_forward, turn, &self.cfg.mount);
         self.pose = self.pose.step(r, f, t);
+        Ok(OdometryStep { pose: self.pose, camera_motion: [cam_right, cam_forward, turn], flows, failure })
+    }
+
+    fn step_robust(&mut self, prev: &Plane<u8>, frame: &Plane<u8>) -> Result<OdometryStep> {
+        let s = self.cfg.process_sigma;
+        let mut p_pred = self.p + Matrix3::from_diagonal(&Vector3::new(s[0] * s[0], s[1] * s[1], s[2] * s[2]));
+        let scale = self.cfg.height_m / self.cfg.focal_px;
+        let fit = window_measurements(prev, frame, &self.cfg.robust)
+            .and_then(|m| fit_rigid(&m, &self.cfg.robust).map(|f| (f, m)));
+        let (flows, failure) = match fit {
+            Ok((f, m)) => {
+                // State (Tx, Ty, wz) = M (right_px, forward_px, turn), M = diag(-s, s, -1).
+                let z = Vector3::new(-scale * f.right_px, scale * f.forward_px, -f.turn_rad);
+                let m_inv = Matrix3::from_diagonal(&Vector3::new(-1.0 / scale, 1.0 / scale, -1.0));
+                let info_z = m_inv.transpose() * f.info * m_inv;
+                let info_prior = p_pred.try_inverse().unwrap_or_else(Matrix3::zeros);
+                let info = info_prior + info_z;
+                let cov = info
+                    .try_inverse()
+                    .ok_or_else(|| OdometryError::NoTexture("the flow does not determine the motion".into()))?;
+                self.x = cov * (info_prior * self.x + info_z * z);
+                p_pred = cov;
+                let flows = m.iter().map(|w| FlowPoint { u: w.u, v: w.v, du: w.du, dv: w.dv, inliers: 1 }).collect();
+                (flows, None)
+            }
+            Err(OdometryError::NoTexture(why)) => (Vec::new(), Some(why)),
+            Err(e) => return Err(e),
+        };
+        self.p = p_pred;
+        let (cam_right, cam_forward, turn) = (-self.x[0], self.x[1], -self.x[2]);
+        self.pose = self.pose.moved_by_camera(cam_right, cam_forward, turn, &self.cfg.mount);
         Ok(OdometryStep { pose: self.pose, camera_motion: [cam_right, cam_forward, turn], flows, failure })
     }
 }
