@@ -1,4 +1,4 @@
-//! `ocellus bench odometry`: visual odometry per frame on one core.
+//! `ocellus bench odometry`: visual odometry per frame on one core, seed and robust modes.
 
 use crate::bench::median;
 use crate::generate_ground::textures;
@@ -22,7 +22,14 @@ pub fn run(json_out: bool) -> Result<()> {
     }
     let mut t_flow = Vec::new();
     let mut t_step = Vec::new();
+    let mut t_robust = Vec::new();
     for _ in 0..3 {
+        let mut vo = VisualOdometry::new(OdometryConfig::robust(0.3, 600.0, Mount { right_m: 0.0, forward_m: 0.05 }))?;
+        for f in &frames {
+            let t = Instant::now();
+            vo.step(f)?;
+            t_robust.push(t.elapsed().as_secs_f64() * 1e3);
+        }
         for w in frames.windows(2) {
             let t = Instant::now();
             let _ = group_flows(&w[0], &w[1], &SadFlowConfig::default());
@@ -36,9 +43,12 @@ pub fn run(json_out: bool) -> Result<()> {
         }
     }
     let step = median(&mut t_step);
+    let robust = median(&mut t_robust);
     let v = json!({
         "ms_per_frame_1thread_seed": step,
         "fps_1thread_seed": 1e3 / step.max(1e-9),
+        "ms_per_frame_1thread_robust": robust,
+        "fps_1thread_robust": 1e3 / robust.max(1e-9),
         "ms_sad_group_flows_1thread": median(&mut t_flow),
     });
     if json_out {

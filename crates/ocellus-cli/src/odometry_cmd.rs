@@ -36,8 +36,9 @@ pub struct OdometryArgs {
     /// Camera position right of the rotation centre, metres (overrides the camera file).
     #[arg(long)]
     mount_right_m: Option<f64>,
-    /// Estimator: `seed` (integer SAD, the seed's filter). The robust mode is not built yet.
-    #[arg(long, value_enum, default_value = "seed")]
+    /// Estimator: `robust` (sub-pixel flow with per-window uncertainty, a robust fit over all
+    /// windows) or `seed` (the seed's integer SAD groups and filter).
+    #[arg(long, value_enum, default_value = "robust")]
     mode: Mode,
     /// Frame rate, Hz (timestamps of the trajectory).
     #[arg(long, default_value_t = 200.0)]
@@ -52,6 +53,8 @@ pub struct OdometryArgs {
 pub enum Mode {
     /// The seed's method (SPEC 6.2-6.3).
     Seed,
+    /// Beyond the seed: sub-pixel, aperture-aware, robust over all windows.
+    Robust,
 }
 
 #[derive(Subcommand, Debug)]
@@ -82,7 +85,6 @@ pub fn run(a: OdometryArgs) -> Result<()> {
         return eval(&e);
     }
     let (Some(input), Some(camera)) = (&a.input, &a.camera) else { bail!("give the frames and --camera") };
-    let Mode::Seed = a.mode;
     let cam = camera_file::read(camera)?;
     let height = a.height_m.or(cam.height_m).context("the camera height: --height-m or height_m in the camera file")?;
     let mount = Mount {
@@ -90,7 +92,11 @@ pub fn run(a: OdometryArgs) -> Result<()> {
         forward_m: a.mount_forward_m.or(cam.mount_forward_m).unwrap_or(0.0),
     };
     let focal = 0.5 * (cam.intrinsics.fx + cam.intrinsics.fy);
-    let mut vo = VisualOdometry::new(OdometryConfig::seed(height, focal, mount))?;
+    let cfg = match a.mode {
+        Mode::Seed => OdometryConfig::seed(height, focal, mount),
+        Mode::Robust => OdometryConfig::robust(height, focal, mount),
+    };
+    let mut vo = VisualOdometry::new(cfg)?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
     let d = cam.distortion;
     let distorted = [d.k1, d.k2, d.k3, d.p1, d.p2].iter().any(|v| *v != 0.0);

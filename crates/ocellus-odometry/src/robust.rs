@@ -20,7 +20,7 @@
 
 use crate::sad_flow::{window_flows, SadFlowConfig};
 use crate::{OdometryError, Result};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Matrix4, Vector4};
 use ocellus_image::Plane;
 
 /// Parameters of the robust measurement.
@@ -75,13 +75,78 @@ fn at(img: &Plane<u8>, x: f64, y: f64) -> f64 {
     top + ay * (bot - top)
 }
 
+/// Mean grey level of the central `region` x `region` pixels.
+fn region_mean(img: &Plane<u8>, region: usize) -> f64 {
+    let (w, h) = img.size();
+    let (x0, y0) = ((w - region.min(w)) / 2, (h - region.min(h)) / 2);
+    let mut s = 0u64;
+    for y in y0..y0 + region.min(h) {
+        s += img.row(y)[x0..x0 + region.min(w)].iter().map(|&v| v as u64).sum::<u64>();
+    }
+    s as f64 / (region.min(w) * region.min(h)).max(1) as f64
+}
+
+/// The Lucas-Kanade normal equations of one block: `[sum gx^2, sum gx gy, sum gy^2,
+/// sum gx e, sum gy e]` with the gradients g and differences e of frame n (times `gain`)
+/// warped by (dx, dy) against frame n-1. The warp has one fractional part for the whole block,
+/// so frame n is resampled once into a patch with a one-pixel border and the gradients are
+/// central differences there (the same as sampling at +-1 pixel).
+#[allow(clippy::too_many_arguments)]
+fn lk_sums(prev: &Plane<u8>, cur: &Plane<u8>, bx: f64, by: f64, b: usize, dx: f64, dy: f64, gain: f64, patch: &mut Vec<f64>) -> [f64; 5] {
+    let n = b + 2;
+    let (sx, sy) = (bx - 1.0 + dx, by - 1.0 + dy);
+    let (fx, fy) = (sx.floor(), sy.floor());
+    let (ax, ay) = (sx - fx, sy - fy);
+    patch.clear();
+    let inside = fx >= 0.0 && fy >= 0.0 && fx as usize + n < cur.width() && fy as usize + n < cur.height();
+    if inside {
+        let (ix, iy) = (fx as usize, fy as usize);
+        let (w00, w10, w01, w11) = ((1.0 - ax) * (1.0 - ay), ax * (1.0 - ay), (1.0 - ax) * ay, ax * ay);
+        for j in 0..n {
+            let (r0, r1) = (&cur.row(iy + j)[ix..ix + n + 1], &cur.row(iy + j + 1)[ix..ix + n + 1]);
+            for i in 0..n {
+                patch.push(
+                    w00 * r0[i] as f64 + w10 * r0[i + 1] as f64 + w01 * r1[i] as f64 + w11 * r1[i + 1] as f64,
+                );
+            }
+        }
+    } else {
+        for j in 0..n {
+            for i in 0..n {
+                patch.push(at(cur, sx + i as f64, sy + j as f64));
+            }
+        }
+    }
+    let mut s = [0.0f64; 5];
+    for j in 1..=b {
+        let prow = prev.row((by as usize + j - 1).min(prev.height() - 1));
+        for i in 1..=b {
+            let c = patch[j * n + i];
+            let gx = 0.5 * gain * (patch[j * n + i + 1] - patch[j * n + i - 1]);
+            let gy = 0.5 * gain * (patch[(j + 1) * n + i] - patch[(j - 1) * n + i]);
+            let e = gain * c - prow[(bx as usize + i - 1).min(prev.width() - 1)] as f64;
+            s[0] += gx * gx;
+            s[1] += gx * gy;
+            s[2] += gy * gy;
+            s[3] += gx * e;
+            s[4] += gy * e;
+        }
+    }
+    s
+}
+
 /// Sub-pixel flows of all textured windows between `prev` and `cur`.
 pub fn window_measurements(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &RobustConfig) -> Result<Vec<WindowMeasurement>> {
     let windows = window_flows(prev, cur, &cfg.flow)?;
     let (cx, cy) = ((prev.width() as f64 - 1.0) / 2.0, (prev.height() as f64 - 1.0) / 2.0);
+    // Brightness robustness: a global gain between the frames (exposure or lighting change),
+    // the ratio of the mean grey levels of the searched region.
+    let gain = region_mean(prev, cfg.flow.region) / region_mean(cur, cfg.flow.region).max(1e-9);
+    let gain = if gain.is_finite() && gain > 0.0 { gain } else { 1.0 };
     let b = cfg.flow.block as i64;
     let half = (b as f64 - 1.0) / 2.0;
     let mut out = Vec::with_capacity(windows.len());
+    let mut patch = Vec::new();
     for wf in &windows {
         let Some((fx, fy)) = wf.flow else { continue };
         let (bx, by) = (wf.x - half, wf.y - half);
@@ -89,28 +154,14 @@ pub fn window_measurements(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &RobustConfig
         let mut tensor = [[0.0f64; 2]; 2];
         let mut ok = true;
         for _ in 0..cfg.lk_steps.max(1) {
-            let (mut a11, mut a12, mut a22, mut b1, mut b2) = (0.0, 0.0, 0.0, 0.0, 0.0);
-            for j in 0..b {
-                for i in 0..b {
-                    let (px, py) = (bx + i as f64, by + j as f64);
-                    let (qx, qy) = (px + dx, py + dy);
-                    let gx = 0.5 * (at(cur, qx + 1.0, qy) - at(cur, qx - 1.0, qy));
-                    let gy = 0.5 * (at(cur, qx, qy + 1.0) - at(cur, qx, qy - 1.0));
-                    let e = at(cur, qx, qy) - prev.get(px as usize, py as usize) as f64;
-                    a11 += gx * gx;
-                    a12 += gx * gy;
-                    a22 += gy * gy;
-                    b1 += gx * e;
-                    b2 += gy * e;
-                }
-            }
+            let [a11, a12, a22, b1, b2] = lk_sums(prev, cur, bx, by, b as usize, dx, dy, gain, &mut patch);
             tensor = [[a11, a12], [a12, a22]];
             let det = a11 * a22 - a12 * a12;
             let n = (b * b) as f64;
             // Smaller eigenvalue per pixel: the texture across the weakest direction.
             let tr = a11 + a22;
             let lmin = 0.5 * (tr - ((a11 - a22).powi(2) + 4.0 * a12 * a12).sqrt()) / n;
-            if !(det > 0.0) || lmin < cfg.min_texture {
+            if det.is_nan() || det <= 0.0 || lmin < cfg.min_texture {
                 ok = false;
                 break;
             }
@@ -155,14 +206,16 @@ pub struct RigidMotion {
     pub inliers: usize,
 }
 
-/// Predicted position of (u, v) after the motion, and its derivatives by (r, f, w).
-fn predict(u: f64, v: f64, p: &Vector3<f64>) -> ([f64; 2], [[f64; 3]; 2]) {
-    let (r, f, w) = (p[0], p[1], p[2]);
+/// Predicted position of (u, v) after the motion (r, f, w) and an image scale change k (the
+/// camera height changing: the model has no use for it, but fitting it keeps the radial flow
+/// it causes out of the other three), and its derivatives by (r, f, w, k).
+fn predict(u: f64, v: f64, p: &Vector4<f64>) -> ([f64; 2], [[f64; 4]; 2]) {
+    let (r, f, w, k) = (p[0], p[1], p[2], p[3]);
     let (s, c) = w.sin_cos();
     let (a, b) = (u - r, v + f);
-    let pu = a * c + b * s;
-    let pv = -a * s + b * c;
-    ([pu, pv], [[-c, s, -a * s + b * c], [s, c, -a * c - b * s]])
+    let (ru, rv) = (a * c + b * s, -a * s + b * c);
+    let m = 1.0 + k;
+    ([m * ru, m * rv], [[-c * m, s * m, (-a * s + b * c) * m, ru], [s * m, c * m, (-a * c - b * s) * m, rv]])
 }
 
 /// Fits the rigid motion to the measurements (see the module doc).
@@ -175,13 +228,13 @@ pub fn fit_rigid(meas: &[WindowMeasurement], cfg: &RobustConfig) -> Result<Rigid
     let mut vs: Vec<f64> = meas.iter().map(|m| m.dv).collect();
     us.sort_by(f64::total_cmp);
     vs.sort_by(f64::total_cmp);
-    let mut p = Vector3::new(-us[us.len() / 2], vs[vs.len() / 2], 0.0);
+    let mut p = Vector4::new(-us[us.len() / 2], vs[vs.len() / 2], 0.0, 0.0);
     let mut keep = vec![true; meas.len()];
-    let mut info = Matrix3::zeros();
+    let mut info = Matrix4::zeros();
     for round in 0..2 {
         for _ in 0..8 {
-            let mut a = Matrix3::zeros();
-            let mut g = Vector3::zeros();
+            let mut a = Matrix4::zeros();
+            let mut g = Vector4::zeros();
             for (m, &k) in meas.iter().zip(&keep) {
                 if !k {
                     continue;
@@ -195,23 +248,19 @@ pub fn fit_rigid(meas: &[WindowMeasurement], cfg: &RobustConfig) -> Result<Rigid
                 let scale = (w[0][0] + w[1][1]).max(1e-12) * 0.5;
                 let px2 = maha / scale;
                 let rw = 1.0 / (1.0 + px2 / (cfg.cauchy_px * cfg.cauchy_px));
-                for r in 0..3 {
-                    for c in 0..3 {
-                        let mut s = 0.0;
-                        for i in 0..2 {
-                            for l in 0..2 {
-                                s += j[i][r] * w[i][l] * j[l][c];
-                            }
-                        }
-                        a[(r, c)] += rw * s;
+                // J^T W (4x2) once, then the rank-2 update of the 4x4 normal matrix.
+                let jtw: [[f64; 2]; 4] =
+                    std::array::from_fn(|r| std::array::from_fn(|l| rw * (j[0][r] * w[0][l] + j[1][r] * w[1][l])));
+                for r in 0..4 {
+                    for c in r..4 {
+                        a[(r, c)] += jtw[r][0] * j[0][c] + jtw[r][1] * j[1][c];
                     }
-                    let mut s = 0.0;
-                    for i in 0..2 {
-                        for l in 0..2 {
-                            s += j[i][r] * w[i][l] * e[l];
-                        }
-                    }
-                    g[r] += rw * s;
+                    g[r] += jtw[r][0] * e[0] + jtw[r][1] * e[1];
+                }
+            }
+            for r in 0..4 {
+                for c in 0..r {
+                    a[(r, c)] = a[(c, r)];
                 }
             }
             let step = a
@@ -235,11 +284,15 @@ pub fn fit_rigid(meas: &[WindowMeasurement], cfg: &RobustConfig) -> Result<Rigid
             }
         }
     }
+    // The information of the three motion parameters with the scale marginalized out.
+    let singular = || OdometryError::NoTexture("the windows do not determine the motion".into());
+    let cov = info.try_inverse().ok_or_else(singular)?;
+    let info3 = cov.fixed_view::<3, 3>(0, 0).into_owned().try_inverse().ok_or_else(singular)?;
     Ok(RigidMotion {
         right_px: p[0],
         forward_px: p[1],
         turn_rad: p[2],
-        info,
+        info: info3,
         inliers: keep.iter().filter(|k| **k).count(),
     })
 }
@@ -250,7 +303,7 @@ mod tests {
 
     #[test]
     fn the_fit_inverts_the_model_exactly_and_resists_outliers() {
-        let truth = Vector3::new(0.37, 2.81, 0.004);
+        let truth = Vector4::new(0.37, 2.81, 0.004, 0.002);
         let mut meas = Vec::new();
         for j in 0..10 {
             for i in 0..10 {

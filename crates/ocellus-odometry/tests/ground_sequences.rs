@@ -11,16 +11,13 @@ fn textures() -> [Plane<f32>; 3] {
         .map(|n| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap().to_luma8().map(|v| v as f32))
 }
 
-/// Runs the seed odometry over a scene: (final drift in % of the path, final heading error in
+/// Runs the odometry over a scene: (final drift in % of the path, final heading error in
 /// degrees).
-fn run(scene: &GroundScene) -> (f64, f64) {
+fn run(scene: &GroundScene, robust: bool) -> (f64, f64) {
     let c = scene.config();
     // 1 ground pixel = 0.5 mm: a camera 0.3 m up with a 600 px focal length.
-    let cfg = OdometryConfig::seed(
-        0.3,
-        600.0,
-        Mount { right_m: c.mount_px[0] * c.metres_per_px, forward_m: c.mount_px[1] * c.metres_per_px },
-    );
+    let mount = Mount { right_m: c.mount_px[0] * c.metres_per_px, forward_m: c.mount_px[1] * c.metres_per_px };
+    let cfg = if robust { OdometryConfig::robust(0.3, 600.0, mount) } else { OdometryConfig::seed(0.3, 600.0, mount) };
     let mut vo = VisualOdometry::new(cfg).unwrap();
     let mut path = 0.0;
     let mut last = scene.pose_m(0).unwrap();
@@ -44,9 +41,22 @@ fn seed_mode_tracks_grass_and_brick() {
     // sign (hundreds of percent), not the method's own error.
     for (texture, bound) in [(GroundTexture::Grass, 4.0), (GroundTexture::Brick, 25.0)] {
         let cfg = GroundConfig { frames: 120, ..GroundConfig::easy(texture, 1) };
-        let (drift, heading) = run(&GroundScene::new(cfg, t.clone()).unwrap());
+        let (drift, heading) = run(&GroundScene::new(cfg, t.clone()).unwrap(), false);
         println!("seed mode, {texture:?}, 120 frames: drift {drift:.3} % of the path, heading error {heading:.3} deg");
         assert!(drift < bound && heading < 2.0, "{texture:?}: drift {drift} %, heading {heading} deg");
+    }
+}
+
+#[test]
+fn robust_mode_stays_within_a_tenth_of_a_percent_on_brick_and_gravel() {
+    // Issue 7's target is a mean final drift of 0.10 % (easy) and a heading error of 0.1
+    // degree; one seed each here, over 120 frames, with some margin for the single run.
+    let t = textures();
+    for texture in [GroundTexture::Brick, GroundTexture::Gravel] {
+        let cfg = GroundConfig { frames: 120, ..GroundConfig::easy(texture, 2) };
+        let (drift, heading) = run(&GroundScene::new(cfg, t.clone()).unwrap(), true);
+        println!("robust mode, {texture:?}, 120 frames: drift {drift:.3} % of the path, heading error {heading:.3} deg");
+        assert!(drift < 0.2 && heading < 0.2, "{texture:?}: drift {drift} %, heading {heading} deg");
     }
 }
 
@@ -64,12 +74,15 @@ fn standing_still_gives_no_motion_and_turning_in_place_the_right_heading() {
     };
     let s = GroundScene::new(still, t.clone()).unwrap();
     let cfg = OdometryConfig::seed(0.3, 600.0, Mount { right_m: 0.0, forward_m: 0.05 });
-    let mut vo = VisualOdometry::new(cfg).unwrap();
-    for k in 0..s.len() {
-        vo.step(&s.frame(k).unwrap()).unwrap();
+    for c in [cfg, OdometryConfig::robust(0.3, 600.0, cfg.mount)] {
+        let mut vo = VisualOdometry::new(c).unwrap();
+        for k in 0..s.len() {
+            vo.step(&s.frame(k).unwrap()).unwrap();
+        }
+        let p = vo.pose();
+        // Noise only: the seed's integer flows are exactly zero; sub-pixel ones nearly.
+        assert!(p.x.hypot(p.y) < 2e-5 && p.theta.abs() < 1e-4, "{:?}: {p:?}", c.mode);
     }
-    let p = vo.pose();
-    assert!(p.x.abs() < 1e-9 && p.y.abs() < 1e-9 && p.theta.abs() < 1e-9, "{p:?}");
     // Turning in place by 0.3 degrees per frame about the rotation centre (camera 5 cm
     // ahead, so the image both turns and slides).
     let turn = GroundConfig { yaw_deg: 0.3, frames: 40, ..still };
@@ -93,9 +106,11 @@ fn standing_still_gives_no_motion_and_turning_in_place_the_right_heading() {
 #[test]
 fn a_blank_floor_is_a_reported_failure() {
     let flat = Plane::from_fn(640, 480, |_, _| 120u8);
-    let mut vo = VisualOdometry::new(OdometryConfig::seed(0.3, 600.0, Mount::default())).unwrap();
-    vo.step(&flat).unwrap();
-    let s = vo.step(&flat).unwrap();
-    assert!(s.failure.is_some() && s.flows.is_empty());
-    assert!(vo.step(&Plane::new(100, 100)).is_err());
+    for cfg in [OdometryConfig::seed(0.3, 600.0, Mount::default()), OdometryConfig::robust(0.3, 600.0, Mount::default())] {
+        let mut vo = VisualOdometry::new(cfg).unwrap();
+        vo.step(&flat).unwrap();
+        let s = vo.step(&flat).unwrap();
+        assert!(s.failure.is_some() && s.flows.is_empty(), "{:?}", cfg.mode);
+        assert!(vo.step(&Plane::new(100, 100)).is_err());
+    }
 }

@@ -11,7 +11,8 @@
 //!   from the robot's rotation centre (seed eq. 20's offset).
 //! - **Camera:** image x to the robot's right, image y backwards; one image pixel is one
 //!   ground pixel at the nominal height (`metres_per_px` on the floor).
-//! - **Hard variant:** motion blur (sub-frame renders over the exposure averaged), gain
+//! - **Hard variant:** motion blur (sub-frame renders over the exposure, centred on the frame
+//!   time, averaged), gain
 //!   flicker, a camera-height oscillation the planar model does not know, stronger noise.
 //!
 //! World frame: x right, y down on the floor (as the first image), angles clockwise from the
@@ -371,25 +372,33 @@ impl GroundScene {
         }
     }
 
-    /// Frame `k` as 8-bit grey: rendered (with motion blur over the exposure before the
-    /// frame time in the hard variant), gain flicker, sensor noise, rounded and clamped.
+    /// The pose at a fractional frame time (between frames the motion of the frame interval
+    /// is followed proportionally), clamped to the sequence.
+    fn pose_at(&self, t: f64) -> Pose2 {
+        let t = t.clamp(0.0, self.len() as f64 - 1.0 + 0.999);
+        let j = t.floor() as usize;
+        let a = t - j as f64;
+        match (self.poses.get(j), self.motion.get(j)) {
+            (Some(p), Some(m)) if a > 0.0 => p.step(m.lateral_px * a, m.forward_px * a, m.yaw_rad * a),
+            (Some(p), _) => *p,
+            _ => Pose2::default(),
+        }
+    }
+
+    /// Frame `k` as 8-bit grey: rendered (with motion blur in the hard variant: sub-frames over
+    /// the exposure, centred on the frame time, as timestamps at mid-exposure), gain flicker,
+    /// sensor noise, rounded and clamped.
     pub fn frame(&self, k: usize) -> Result<Plane<u8>> {
-        let pose = self.pose(k).ok_or(SynthError::NoSuchFrame { index: k, len: self.len() })?;
+        if k >= self.len() {
+            return Err(SynthError::NoSuchFrame { index: k, len: self.len() });
+        }
         let (w, h) = (self.cfg.width, self.cfg.height);
         let mut acc = Plane::<f32>::new(w, h);
         let n = self.cfg.blur_subframes;
-        let prev = if k > 0 { self.motion.get(k - 1).copied() } else { None };
         for s in 0..n {
-            // Sub-frame s of n spreads over the exposure, the last one at the frame time.
-            let back = if n > 1 { self.cfg.exposure * (n - 1 - s) as f64 / (n - 1) as f64 } else { 0.0 };
-            let p = match (prev, self.pose(k.wrapping_sub(1))) {
-                (Some(m), Some(p0)) if back > 0.0 => {
-                    let a = 1.0 - back;
-                    p0.step(m.lateral_px * a, m.forward_px * a, m.yaw_rad * a)
-                }
-                _ => pose,
-            };
-            self.render_at(&p, self.scale(k as f64 - back), &mut acc, 1.0 / n as f32);
+            let offset = if n > 1 { self.cfg.exposure * (s as f64 / (n - 1) as f64 - 0.5) } else { 0.0 };
+            let t = k as f64 + offset;
+            self.render_at(&self.pose_at(t), self.scale(t), &mut acc, 1.0 / n as f32);
         }
         let mut rng = SplitMix64::new(self.cfg.seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ k as u64);
         let gain = 1.0 + self.cfg.gain_flicker * (2.0 * rng.unit() as f32 - 1.0);
