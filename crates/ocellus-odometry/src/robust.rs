@@ -92,7 +92,17 @@ fn region_mean(img: &Plane<u8>, region: usize) -> f64 {
 /// so frame n is resampled once into a patch with a one-pixel border and the gradients are
 /// central differences there (the same as sampling at +-1 pixel).
 #[allow(clippy::too_many_arguments)]
-fn lk_sums(prev: &Plane<u8>, cur: &Plane<u8>, bx: f64, by: f64, b: usize, dx: f64, dy: f64, gain: f64, patch: &mut Vec<f64>) -> [f64; 5] {
+fn lk_sums(
+    prev: &Plane<u8>,
+    cur: &Plane<u8>,
+    bx: f64,
+    by: f64,
+    b: usize,
+    dx: f64,
+    dy: f64,
+    gain: f64,
+    patch: &mut Vec<f64>,
+) -> [f64; 5] {
     let n = b + 2;
     let (sx, sy) = (bx - 1.0 + dx, by - 1.0 + dy);
     let (fx, fy) = (sx.floor(), sy.floor());
@@ -105,9 +115,7 @@ fn lk_sums(prev: &Plane<u8>, cur: &Plane<u8>, bx: f64, by: f64, b: usize, dx: f6
         for j in 0..n {
             let (r0, r1) = (&cur.row(iy + j)[ix..ix + n + 1], &cur.row(iy + j + 1)[ix..ix + n + 1]);
             for i in 0..n {
-                patch.push(
-                    w00 * r0[i] as f64 + w10 * r0[i + 1] as f64 + w01 * r1[i] as f64 + w11 * r1[i + 1] as f64,
-                );
+                patch.push(w00 * r0[i] as f64 + w10 * r0[i + 1] as f64 + w01 * r1[i] as f64 + w11 * r1[i + 1] as f64);
             }
         }
     } else {

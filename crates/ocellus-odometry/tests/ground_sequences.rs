@@ -55,7 +55,9 @@ fn robust_mode_stays_within_a_tenth_of_a_percent_on_brick_and_gravel() {
     for texture in [GroundTexture::Brick, GroundTexture::Gravel] {
         let cfg = GroundConfig { frames: 120, ..GroundConfig::easy(texture, 2) };
         let (drift, heading) = run(&GroundScene::new(cfg, t.clone()).unwrap(), true);
-        println!("robust mode, {texture:?}, 120 frames: drift {drift:.3} % of the path, heading error {heading:.3} deg");
+        println!(
+            "robust mode, {texture:?}, 120 frames: drift {drift:.3} % of the path, heading error {heading:.3} deg"
+        );
         assert!(drift < 0.2 && heading < 0.2, "{texture:?}: drift {drift} %, heading {heading} deg");
     }
 }
@@ -106,7 +108,9 @@ fn standing_still_gives_no_motion_and_turning_in_place_the_right_heading() {
 #[test]
 fn a_blank_floor_is_a_reported_failure() {
     let flat = Plane::from_fn(640, 480, |_, _| 120u8);
-    for cfg in [OdometryConfig::seed(0.3, 600.0, Mount::default()), OdometryConfig::robust(0.3, 600.0, Mount::default())] {
+    for cfg in
+        [OdometryConfig::seed(0.3, 600.0, Mount::default()), OdometryConfig::robust(0.3, 600.0, Mount::default())]
+    {
         let mut vo = VisualOdometry::new(cfg).unwrap();
         vo.step(&flat).unwrap();
         let s = vo.step(&flat).unwrap();
