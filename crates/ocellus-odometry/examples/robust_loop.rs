@@ -22,4 +22,24 @@ fn main() {
     }
     t.sort_by(f64::total_cmp);
     println!("robust median {:.3} ms", t[t.len() / 2]);
+    // Stage split: integer search, search + Lucas-Kanade, fit.
+    let cfg = ocellus_odometry::robust::RobustConfig::default();
+    let (mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..10 {
+        for w in frames.windows(2) {
+            let s = std::time::Instant::now();
+            let _ = ocellus_odometry::sad_flow::window_flows(&w[0], &w[1], &cfg.flow).unwrap();
+            a.push(s.elapsed().as_secs_f64() * 1e3);
+            let s = std::time::Instant::now();
+            let m = ocellus_odometry::robust::window_measurements(&w[0], &w[1], &cfg).unwrap();
+            b.push(s.elapsed().as_secs_f64() * 1e3);
+            let s = std::time::Instant::now();
+            let _ = ocellus_odometry::robust::fit_rigid(&m, &cfg).unwrap();
+            c.push(s.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    for v in [&mut a, &mut b, &mut c] {
+        v.sort_by(f64::total_cmp);
+    }
+    println!("search {:.3} ms, search + LK {:.3} ms, fit {:.3} ms", a[a.len() / 2], b[b.len() / 2], c[c.len() / 2]);
 }
