@@ -8,6 +8,7 @@
 //!   mounted off the rotation centre).
 //! - [`robust`]: beyond the seed: sub-pixel Lucas-Kanade refinement with per-window
 //!   uncertainty (the aperture problem), a robust fit of the exact rigid motion over all windows.
+//! - [`fusion`]: wheel encoders fused with vision: slips rejected, texture gaps bridged.
 //! - [`vo`]: the Kalman filter on the camera motion (Tx, Ty, wz) with the image-Jacobian
 //!   measurement model, in information form, and the integration to a robot trajectory.
 //!
@@ -22,6 +23,7 @@
 //! assert!((p.y + 1.0).abs() < 1e-12); // forward is -y at heading 0
 //! ```
 
+pub mod fusion;
 pub mod kinematics;
 pub mod robust;
 pub mod sad_flow;

@@ -101,6 +101,8 @@ pub struct OdometryStep {
     pub pose: Pose2,
     /// The filtered camera motion of this frame: right (m), forward (m), turn (rad).
     pub camera_motion: [f64; 3],
+    /// Standard deviations of `camera_motion` from the filter's covariance (m, m, rad).
+    pub camera_motion_sigma: [f64; 3],
     /// The flow vectors measured (empty for the first frame and on failure).
     pub flows: Vec<FlowPoint>,
     /// Why no measurement was used (the motion was then predicted), if so.
@@ -136,10 +138,21 @@ impl VisualOdometry {
         self.pose
     }
 
+    /// Standard deviations of the current motion estimate (right m, forward m, turn rad).
+    fn sigma(&self) -> [f64; 3] {
+        [self.p[(0, 0)].max(0.0).sqrt(), self.p[(1, 1)].max(0.0).sqrt(), self.p[(2, 2)].max(0.0).sqrt()]
+    }
+
     /// Processes the next frame (grey, the same size as the previous ones).
     pub fn step(&mut self, frame: &Plane<u8>) -> Result<OdometryStep> {
         let Some(prev) = self.prev.replace(frame.clone()) else {
-            return Ok(OdometryStep { pose: self.pose, camera_motion: [0.0; 3], flows: Vec::new(), failure: None });
+            return Ok(OdometryStep {
+                pose: self.pose,
+                camera_motion: [0.0; 3],
+                camera_motion_sigma: [0.0; 3],
+                flows: Vec::new(),
+                failure: None,
+            });
         };
         if self.cfg.mode == Mode::Robust {
             return self.step_robust(&prev, frame);
@@ -175,7 +188,13 @@ impl VisualOdometry {
         let (cam_right, cam_forward, turn) = (-self.x[0], self.x[1], -self.x[2]);
         let (r, f, t) = robot_motion(cam_right, cam_forward, turn, &self.cfg.mount);
         self.pose = self.pose.step(r, f, t);
-        Ok(OdometryStep { pose: self.pose, camera_motion: [cam_right, cam_forward, turn], flows, failure })
+        Ok(OdometryStep {
+            pose: self.pose,
+            camera_motion: [cam_right, cam_forward, turn],
+            camera_motion_sigma: self.sigma(),
+            flows,
+            failure,
+        })
     }
 
     fn step_robust(&mut self, prev: &Plane<u8>, frame: &Plane<u8>) -> Result<OdometryStep> {
@@ -206,6 +225,12 @@ impl VisualOdometry {
         self.p = p_pred;
         let (cam_right, cam_forward, turn) = (-self.x[0], self.x[1], -self.x[2]);
         self.pose = self.pose.moved_by_camera(cam_right, cam_forward, turn, &self.cfg.mount);
-        Ok(OdometryStep { pose: self.pose, camera_motion: [cam_right, cam_forward, turn], flows, failure })
+        Ok(OdometryStep {
+            pose: self.pose,
+            camera_motion: [cam_right, cam_forward, turn],
+            camera_motion_sigma: self.sigma(),
+            flows,
+            failure,
+        })
     }
 }
