@@ -9,6 +9,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use ocellus_geometry::distortion::{remap_bilinear, undistort_maps};
 use ocellus_image::Plane;
 use ocellus_io::tum::TumPose;
+use ocellus_odometry::fusion::{encoder_motion, EncoderReading, Fusion, FusionConfig};
 use ocellus_odometry::kinematics::Mount;
 use ocellus_odometry::vo::{OdometryConfig, VisualOdometry};
 use plotters::style::RGBColor;
@@ -43,7 +44,15 @@ pub struct OdometryArgs {
     /// Frame rate, Hz (timestamps of the trajectory).
     #[arg(long, default_value_t = 200.0)]
     rate_hz: f64,
-    /// Output folder: trajectory.tum, trajectory.png, flow_NNNNN.png for a few frames.
+    /// Wheel encoders to fuse: CSV `time_s,forward_m,yaw_rad` (a header allowed), one reading
+    /// per interval ending at time_s (e.g. `encoders.csv` of `synth ground`).
+    #[arg(long)]
+    encoders: Option<PathBuf>,
+    /// Encoder rate, Hz.
+    #[arg(long, default_value_t = 30.0)]
+    encoder_rate_hz: f64,
+    /// Output folder: trajectory.tum (fused with the encoders when given; then also
+    /// trajectory_vision.tum), trajectory.png, flow_NNNNN.png for a few frames.
     #[arg(long, default_value = "ocellus-odometry")]
     out: PathBuf,
 }
@@ -97,6 +106,23 @@ pub fn run(a: OdometryArgs) -> Result<()> {
         Mode::Robust => OdometryConfig::robust(height, focal, mount),
     };
     let mut vo = VisualOdometry::new(cfg)?;
+    let readings: Option<Vec<EncoderReading>> = match &a.encoders {
+        Some(p) => {
+            let rows = ocellus_io::csv::read_rows(p, 3, "'time_s,forward_m,yaw_rad'")?;
+            let r: Vec<EncoderReading> =
+                rows.iter().map(|r| EncoderReading { time_s: r[0], forward_m: r[1], yaw_rad: r[2] }).collect();
+            if r.windows(2).any(|w| w[1].time_s <= w[0].time_s) {
+                bail!("{}: encoder times must increase", p.display());
+            }
+            Some(r)
+        }
+        None => None,
+    };
+    if !(a.encoder_rate_hz > 0.0 && a.rate_hz > 0.0) {
+        bail!("--rate-hz and --encoder-rate-hz must be positive");
+    }
+    let mut fusion = Fusion::new(FusionConfig { encoder_rate_hz: a.encoder_rate_hz, ..Default::default() }, mount);
+    let mut vision_poses = Vec::new();
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
     let d = cam.distortion;
     let distorted = [d.k1, d.k2, d.k3, d.p1, d.p2].iter().any(|v| *v != 0.0);
@@ -118,13 +144,35 @@ pub fn run(a: OdometryArgs) -> Result<()> {
         if k > 0 && k % 50 == 1 {
             write_flow(&a.out.join(format!("flow_{k:05}.png")), &grey, &step.flows)?;
         }
+        let t = k as f64 / a.rate_hz;
         let p = step.pose;
-        poses.push(TumPose::planar(k as f64 / a.rate_hz, p.x, p.y, p.theta));
+        vision_poses.push(TumPose::planar(t, p.x, p.y, p.theta));
+        if let Some(r) = &readings {
+            if k > 0 {
+                fusion.step(&step, encoder_motion(r, a.encoder_rate_hz, t - 1.0 / a.rate_hz, t));
+            }
+            let f = fusion.pose();
+            poses.push(TumPose::planar(t, f.x, f.y, f.theta));
+        } else {
+            poses.push(TumPose::planar(t, p.x, p.y, p.theta));
+        }
         Ok(())
     })?;
     let secs = t0.elapsed().as_secs_f64();
     ocellus_io::tum::write(a.out.join("trajectory.tum"), &poses)?;
-    plot_trajectories(&a.out.join("trajectory.png"), &[("estimate", &poses, RGBColor(200, 40, 40))])?;
+    if readings.is_some() {
+        ocellus_io::tum::write(a.out.join("trajectory_vision.tum"), &vision_poses)?;
+        plot_trajectories(
+            &a.out.join("trajectory.png"),
+            &[("fused", &poses, RGBColor(200, 40, 40)), ("vision", &vision_poses, RGBColor(40, 90, 200))],
+        )?;
+        println!(
+            "encoders: {} frames with slipping wheels ignored, {} bridged by the wheels",
+            fusion.rejected, fusion.bridged
+        );
+    } else {
+        plot_trajectories(&a.out.join("trajectory.png"), &[("estimate", &poses, RGBColor(200, 40, 40))])?;
+    }
     let last = poses.last().context("no frames")?;
     println!(
         "{n} frames in {secs:.2} s ({:.0} fps, decoding included); {failures} without texture; final pose ({:.4}, {:.4}) m, {:.2} deg",

@@ -52,6 +52,18 @@ fn generate_estimate_and_evaluate_a_ground_sequence() {
     // gives tens or hundreds).
     assert!(drift < 10.0, "{e}");
     assert!(dir.join("p.png").is_file());
+    // With the wheel encoders: the fused trajectory and the vision-only one.
+    let fused = dir.join("fused");
+    let f = run(ocellus()
+        .arg("odometry")
+        .arg(seq.join("sequence.y4m"))
+        .arg("--camera")
+        .arg(seq.join("camera.toml"))
+        .arg("--encoders")
+        .arg(seq.join("encoders.csv"))
+        .arg("--out")
+        .arg(&fused));
+    assert!(f.contains("encoders:") && fused.join("trajectory_vision.tum").is_file(), "{f}");
     // The ground truth against itself: no error at all.
     let z = run(ocellus()
         .args(["odometry", "eval"])

@@ -1,15 +1,19 @@
 //! Wheel encoders fused with visual odometry (SPEC 6.5, the seed's stated future work).
 //!
 //! Encoders report, at their own rate (e.g. 30 Hz), the forward distance and the turn of each
-//! interval; wheels see no lateral motion, and they slip. Vision reports every frame's motion
-//! with its uncertainty, and fails on a floor without texture. Per camera frame:
+//! interval; wheels see no sideways motion, and they slip. Vision reports every frame's motion
+//! and fails on a floor without texture. Per camera frame:
 //! - the encoder motion over the frame interval is taken from the readings that overlap it
 //!   (each reading spread evenly over its interval);
-//! - with both, forward distance and turn are combined by inverse variance, unless they
-//!   disagree by more than `gate` standard deviations: the wheels slipped (or were lifted),
-//!   and vision alone is used;
+//! - when vision measured the frame, its motion is used and the wheels are only compared with
+//!   it: frames where they disagree by more than `gate` standard deviations (1 % wheel noise
+//!   against the filter's uncertainty) are counted as slips. Averaging the two was tried: on
+//!   the generated sequences the visual estimate is more accurate per frame than the filter's
+//!   conservative covariance says, and averaging in the wheels made the fused drift worse
+//!   (0.09 % against 0.03 % on the mosaic), so vision is not diluted;
 //! - without vision, the wheels bridge the gap for forward motion and turn, and the visual
-//!   filter's prediction (its last velocity) for the sideways motion wheels cannot see.
+//!   filter's prediction (its last velocity) stands in for the sideways motion wheels cannot
+//!   see.
 
 use crate::kinematics::{Mount, Pose2};
 use crate::vo::OdometryStep;
@@ -34,7 +38,7 @@ pub struct FusionConfig {
     pub encoder_rel_sigma: f64,
     /// Floor of the encoder standard deviation per frame (metres; radians for the turn).
     pub encoder_min_sigma: f64,
-    /// Disagreement (in combined standard deviations) beyond which the wheels are ignored.
+    /// Disagreement (in combined standard deviations) counted as a slip.
     pub gate: f64,
 }
 
@@ -73,7 +77,7 @@ pub struct Fusion {
     cfg: FusionConfig,
     mount: Mount,
     pose: Pose2,
-    /// Frames where the wheels were ignored (disagreement) and where they bridged vision.
+    /// Frames where the wheels disagreed with vision (slips).
     pub rejected: usize,
     /// Frames bridged by the wheels alone.
     pub bridged: usize,
@@ -102,24 +106,19 @@ impl Fusion {
             (true, Some((wf, wt))) => {
                 let ef = self.cfg.encoder_rel_sigma * wf.abs() + self.cfg.encoder_min_sigma;
                 let et = self.cfg.encoder_rel_sigma * wt.abs() + self.cfg.encoder_min_sigma;
-                let (vsf, vst) = ((sf * sf + (m.right_m * st).powi(2)).max(1e-30), (st * st).max(1e-30));
+                let (vsf, vst) = (sf * sf + (m.right_m * st).powi(2), st * st);
                 let agree = (vf - wf).abs() <= self.cfg.gate * (vsf + ef * ef).sqrt()
                     && (vt - wt).abs() <= self.cfg.gate * (vst + et * et).sqrt();
-                if agree {
-                    let fuse = |a: f64, va: f64, b: f64, vb: f64| (a / va + b / vb) / (1.0 / va + 1.0 / vb);
-                    (vr, fuse(vf, vsf, wf, ef * ef), fuse(vt, vst, wt, et * et))
-                } else {
+                if !agree {
                     self.rejected += 1;
-                    (vr, vf, vt)
                 }
+                (vr, vf, vt)
             }
-            (true, None) => (vr, vf, vt),
             (false, Some((wf, wt))) => {
-                // Wheels cannot see sideways motion: the filter's prediction stands in for it.
                 self.bridged += 1;
                 (vr, wf, wt)
             }
-            (false, None) => (vr, vf, vt),
+            (_, None) => (vr, vf, vt),
         };
         self.pose = self.pose.step(right, forward, turn);
         self.pose
