@@ -2,10 +2,9 @@
 //! robust fit of the camera motion over all windows.
 //!
 //! 1. Every window's integer SAD match ([`crate::sad_flow::window_flows`]) is refined by
-//!    Gauss-Newton steps of Lucas-Kanade on the block (Lucas & Kanade 1981), in the inverse
-//!    compositional form (Baker & Matthews 2004): with the gradients g of the block in frame
-//!    n-1, each step solves `(sum g g^T) d = sum g (I_n(warped) - I_n-1)` and moves the match
-//!    back by d. The 2x2 structure tensor `sum g g^T` is also the
+//!    Gauss-Newton steps of Lucas-Kanade on the block (Lucas & Kanade 1981): with the image
+//!    gradients g of frame n at the matched block, the correction solves
+//!    `(sum g g^T) d = -sum g (I_n - I_n-1)`. The 2x2 structure tensor `sum g g^T` is also the
 //!    window's information: a block on a straight mortar line constrains the flow across the
 //!    line only (the aperture problem), and a flat block nothing; blocks whose smaller
 //!    eigenvalue is below `min_texture` are dropped.
@@ -87,29 +86,61 @@ fn region_mean(img: &Plane<u8>, region: usize) -> f64 {
     s as f64 / (region.min(w) * region.min(h)).max(1) as f64
 }
 
-/// Frame n resampled (bilinear) on a `b` x `b` grid starting at (x, y): one fractional part
-/// for the whole block, so four fixed weights.
-fn resample(cur: &Plane<u8>, x: f64, y: f64, b: usize, patch: &mut Vec<f64>) {
-    let (fx, fy) = (x.floor(), y.floor());
-    let (ax, ay) = (x - fx, y - fy);
+/// The Lucas-Kanade normal equations of one block: `[sum gx^2, sum gx gy, sum gy^2,
+/// sum gx e, sum gy e]` with the gradients g and differences e of frame n (times `gain`)
+/// warped by (dx, dy) against frame n-1. The warp has one fractional part for the whole block,
+/// so frame n is resampled once into a patch with a one-pixel border and the gradients are
+/// central differences there (the same as sampling at +-1 pixel).
+#[allow(clippy::too_many_arguments)]
+fn lk_sums(
+    prev: &Plane<u8>,
+    cur: &Plane<u8>,
+    bx: f64,
+    by: f64,
+    b: usize,
+    dx: f64,
+    dy: f64,
+    gain: f64,
+    patch: &mut Vec<f64>,
+) -> [f64; 5] {
+    let n = b + 2;
+    let (sx, sy) = (bx - 1.0 + dx, by - 1.0 + dy);
+    let (fx, fy) = (sx.floor(), sy.floor());
+    let (ax, ay) = (sx - fx, sy - fy);
     patch.clear();
-    let inside = fx >= 0.0 && fy >= 0.0 && fx as usize + b < cur.width() && fy as usize + b < cur.height();
-    if !inside {
-        for j in 0..b {
-            for i in 0..b {
-                patch.push(at(cur, x + i as f64, y + j as f64));
+    let inside = fx >= 0.0 && fy >= 0.0 && fx as usize + n < cur.width() && fy as usize + n < cur.height();
+    if inside {
+        let (ix, iy) = (fx as usize, fy as usize);
+        let (w00, w10, w01, w11) = ((1.0 - ax) * (1.0 - ay), ax * (1.0 - ay), (1.0 - ax) * ay, ax * ay);
+        for j in 0..n {
+            let (r0, r1) = (&cur.row(iy + j)[ix..ix + n + 1], &cur.row(iy + j + 1)[ix..ix + n + 1]);
+            for i in 0..n {
+                patch.push(w00 * r0[i] as f64 + w10 * r0[i + 1] as f64 + w01 * r1[i] as f64 + w11 * r1[i + 1] as f64);
             }
         }
-        return;
-    }
-    let (ix, iy) = (fx as usize, fy as usize);
-    let (w00, w10, w01, w11) = ((1.0 - ax) * (1.0 - ay), ax * (1.0 - ay), (1.0 - ax) * ay, ax * ay);
-    for j in 0..b {
-        let (r0, r1) = (&cur.row(iy + j)[ix..ix + b + 1], &cur.row(iy + j + 1)[ix..ix + b + 1]);
-        for i in 0..b {
-            patch.push(w00 * r0[i] as f64 + w10 * r0[i + 1] as f64 + w01 * r1[i] as f64 + w11 * r1[i + 1] as f64);
+    } else {
+        for j in 0..n {
+            for i in 0..n {
+                patch.push(at(cur, sx + i as f64, sy + j as f64));
+            }
         }
     }
+    let mut s = [0.0f64; 5];
+    for j in 1..=b {
+        let prow = prev.row((by as usize + j - 1).min(prev.height() - 1));
+        for i in 1..=b {
+            let c = patch[j * n + i];
+            let gx = 0.5 * gain * (patch[j * n + i + 1] - patch[j * n + i - 1]);
+            let gy = 0.5 * gain * (patch[(j + 1) * n + i] - patch[(j - 1) * n + i]);
+            let e = gain * c - prow[(bx as usize + i - 1).min(prev.width() - 1)] as f64;
+            s[0] += gx * gx;
+            s[1] += gx * gy;
+            s[2] += gy * gy;
+            s[3] += gx * e;
+            s[4] += gy * e;
+        }
+    }
+    s
 }
 
 /// Sub-pixel flows of all textured windows between `prev` and `cur`.
@@ -124,55 +155,27 @@ pub fn window_measurements(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &RobustConfig
     let half = (b as f64 - 1.0) / 2.0;
     let mut out = Vec::with_capacity(windows.len());
     let mut patch = Vec::new();
-    let bu = b as usize;
-    let mut grads = vec![[0.0f64; 2]; bu * bu];
     for wf in &windows {
         let Some((fx, fy)) = wf.flow else { continue };
         let (bx, by) = (wf.x - half, wf.y - half);
-        // Inverse compositional (Baker & Matthews 2004): the gradients and the structure
-        // tensor come from the block of frame n-1, once; each step only resamples frame n.
-        let (ix, iy) = (bx as usize, by as usize);
-        let (mut a11, mut a12, mut a22) = (0.0, 0.0, 0.0);
-        let interior = ix >= 1 && iy >= 1 && ix + bu < prev.width() && iy + bu < prev.height();
-        for j in 0..bu {
-            for i in 0..bu {
-                let (x, y) = (ix + i, iy + j);
-                let (gx, gy) = if interior {
-                    let (up, row, down) = (prev.row(y - 1), prev.row(y), prev.row(y + 1));
-                    (0.5 * (row[x + 1] as f64 - row[x - 1] as f64), 0.5 * (down[x] as f64 - up[x] as f64))
-                } else {
-                    let g = |x: usize, y: usize| prev.get(x.min(prev.width() - 1), y.min(prev.height() - 1)) as f64;
-                    (0.5 * (g(x + 1, y) - g(x.saturating_sub(1), y)), 0.5 * (g(x, y + 1) - g(x, y.saturating_sub(1))))
-                };
-                grads[j * bu + i] = [gx, gy];
-                a11 += gx * gx;
-                a12 += gx * gy;
-                a22 += gy * gy;
-            }
-        }
-        let det = a11 * a22 - a12 * a12;
-        let n = (b * b) as f64;
-        // Smaller eigenvalue per pixel: the texture across the weakest direction.
-        let lmin = 0.5 * ((a11 + a22) - ((a11 - a22).powi(2) + 4.0 * a12 * a12).sqrt()) / n;
-        if det.is_nan() || det <= 0.0 || lmin < cfg.min_texture {
-            continue;
-        }
         let (mut dx, mut dy) = (fx as f64, fy as f64);
+        let mut tensor = [[0.0f64; 2]; 2];
         let mut ok = true;
         for _ in 0..cfg.lk_steps.max(1) {
-            resample(cur, bx + dx, by + dy, bu, &mut patch);
-            let (mut b1, mut b2) = (0.0, 0.0);
-            for j in 0..bu {
-                let prow = &prev.row(iy + j)[ix..ix + bu];
-                for i in 0..bu {
-                    let e = gain * patch[j * bu + i] - prow[i] as f64;
-                    let [gx, gy] = grads[j * bu + i];
-                    b1 += gx * e;
-                    b2 += gy * e;
-                }
+            let [a11, a12, a22, b1, b2] = lk_sums(prev, cur, bx, by, b as usize, dx, dy, gain, &mut patch);
+            tensor = [[a11, a12], [a12, a22]];
+            let det = a11 * a22 - a12 * a12;
+            let n = (b * b) as f64;
+            // Smaller eigenvalue per pixel: the texture across the weakest direction.
+            let tr = a11 + a22;
+            let lmin = 0.5 * (tr - ((a11 - a22).powi(2) + 4.0 * a12 * a12).sqrt()) / n;
+            if det.is_nan() || det <= 0.0 || lmin < cfg.min_texture {
+                ok = false;
+                break;
             }
-            dx -= (a22 * b1 - a12 * b2) / det;
-            dy -= (a11 * b2 - a12 * b1) / det;
+            let (sx, sy) = ((a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det);
+            dx -= sx;
+            dy -= sy;
             if (dx - fx as f64).abs() > 1.0 || (dy - fy as f64).abs() > 1.0 {
                 ok = false;
                 break;
@@ -186,7 +189,7 @@ pub fn window_measurements(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &RobustConfig
                 v: wf.y - cy,
                 du: dx,
                 dv: dy,
-                info: [[a11 / s2, a12 / s2], [a12 / s2, a22 / s2]],
+                info: [[tensor[0][0] / s2, tensor[0][1] / s2], [tensor[1][0] / s2, tensor[1][1] / s2]],
             });
         }
     }
