@@ -10,6 +10,7 @@
 //! - [`homography`]: plane-to-image homographies (normalized DLT).
 //! - [`zhang`]: planar-target calibration: Zhang's closed form, then Levenberg-Marquardt over
 //!   intrinsics, distortion and poses, with parameter standard deviations.
+//! - [`planar`]: planar robot poses (position and heading on the floor).
 //! - [`triangulate`]: points from two views (the seed's 4x3 least squares) and from N views (SVD).
 //! - [`stereo`]: parallel stereo with explicit units (disparity, depth, pixel sizes).
 //! - [`block_matching`]: dense disparity by SAD block matching with uniqueness and
@@ -33,6 +34,7 @@ pub mod chessboard;
 pub mod distortion;
 pub mod dlt;
 pub mod homography;
+pub mod planar;
 pub mod sgm;
 pub mod stereo;
 pub mod triangulate;

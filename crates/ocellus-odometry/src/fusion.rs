@@ -15,7 +15,7 @@
 //!   filter's prediction (its last velocity) stands in for the sideways motion wheels cannot
 //!   see.
 
-use crate::kinematics::{Mount, Pose2};
+use crate::kinematics::{moved_by_camera, Mount, Pose2};
 use crate::vo::OdometryStep;
 
 /// One encoder reading: the motion over the interval ending at `time_s`.
@@ -100,7 +100,7 @@ impl Fusion {
         let [_, sf, st] = vision.camera_motion_sigma;
         let m = &self.mount;
         // The robot's own motion from the camera's, exactly (its pose seen from where it was).
-        let rel = Pose2::default().moved_by_camera(cr, cf, ct, m);
+        let rel = moved_by_camera(&Pose2::default(), cr, cf, ct, m);
         let (vr, vf, vt) = (rel.x, -rel.y, rel.theta);
         let (right, forward, turn) = match (vision.failure.is_none(), wheels) {
             (true, Some((wf, wt))) => {

@@ -12,7 +12,7 @@
 //! `+dv` forward (image y points backwards), and turned by `-wz` (clockwise positive); the
 //! robot's motion follows with the mount offset ([`crate::kinematics::robot_motion`]).
 
-use crate::kinematics::{robot_motion, Mount, Pose2};
+use crate::kinematics::{moved_by_camera, robot_motion, Mount, Pose2};
 use crate::robust::{fit_rigid, window_measurements, RobustConfig};
 use crate::sad_flow::{group_flows, FlowPoint, SadFlowConfig};
 use crate::{OdometryError, Result};
@@ -224,7 +224,7 @@ impl VisualOdometry {
         };
         self.p = p_pred;
         let (cam_right, cam_forward, turn) = (-self.x[0], self.x[1], -self.x[2]);
-        self.pose = self.pose.moved_by_camera(cam_right, cam_forward, turn, &self.cfg.mount);
+        self.pose = moved_by_camera(&self.pose, cam_right, cam_forward, turn, &self.cfg.mount);
         Ok(OdometryStep {
             pose: self.pose,
             camera_motion: [cam_right, cam_forward, turn],

@@ -152,41 +152,8 @@ impl GroundConfig {
     }
 }
 
-/// A planar pose: position of the rotation centre (ground pixels) and heading (radians,
-/// clockwise from the first image's up).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Pose2 {
-    /// x, ground pixels.
-    pub x: f64,
-    /// y, ground pixels.
-    pub y: f64,
-    /// Heading, radians.
-    pub theta: f64,
-}
-
-impl Pose2 {
-    /// Unit vectors of the robot's right and forward directions in the world.
-    pub fn axes(&self) -> ([f64; 2], [f64; 2]) {
-        let (s, c) = self.theta.sin_cos();
-        ([c, s], [s, -c])
-    }
-
-    /// Moves by `right`, `forward` (robot frame, before turning) and turns by `dtheta`.
-    pub fn step(&self, right: f64, forward: f64, dtheta: f64) -> Pose2 {
-        let (r, f) = self.axes();
-        Pose2 {
-            x: self.x + r[0] * right + f[0] * forward,
-            y: self.y + r[1] * right + f[1] * forward,
-            theta: self.theta + dtheta,
-        }
-    }
-
-    /// The point at `(right, forward)` in the robot frame, in the world.
-    pub fn point(&self, right: f64, forward: f64) -> [f64; 2] {
-        let (r, f) = self.axes();
-        [self.x + r[0] * right + f[0] * forward, self.y + r[1] * right + f[1] * forward]
-    }
-}
+/// Planar poses of the rotation centre, here in ground pixels.
+pub use ocellus_geometry::planar::Pose2;
 
 /// Per-frame body velocities: (lateral px, forward px, yaw rad), the robot frame of the start
 /// of the frame.
