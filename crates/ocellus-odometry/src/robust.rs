@@ -75,15 +75,20 @@ fn at(img: &Plane<u8>, x: f64, y: f64) -> f64 {
     top + ay * (bot - top)
 }
 
-/// Mean grey level of the central `region` x `region` pixels.
+/// Mean grey level of the central `region` x `region` pixels, over every other row and
+/// column (40,000 samples for the defaults: plenty for a gain).
 fn region_mean(img: &Plane<u8>, region: usize) -> f64 {
     let (w, h) = img.size();
-    let (x0, y0) = ((w - region.min(w)) / 2, (h - region.min(h)) / 2);
-    let mut s = 0u64;
-    for y in y0..y0 + region.min(h) {
-        s += img.row(y)[x0..x0 + region.min(w)].iter().map(|&v| v as u64).sum::<u64>();
+    let (rw, rh) = (region.min(w), region.min(h));
+    let (x0, y0) = ((w - rw) / 2, (h - rh) / 2);
+    let (mut s, mut n) = (0u64, 0u64);
+    for y in (y0..y0 + rh).step_by(2) {
+        for &v in img.row(y)[x0..x0 + rw].iter().step_by(2) {
+            s += v as u64;
+            n += 1;
+        }
     }
-    s as f64 / (region.min(w) * region.min(h)).max(1) as f64
+    s as f64 / n.max(1) as f64
 }
 
 /// The Lucas-Kanade normal equations of one block: `[sum gx^2, sum gx gy, sum gy^2,
@@ -101,43 +106,61 @@ fn lk_sums(
     dx: f64,
     dy: f64,
     gain: f64,
-    patch: &mut Vec<f64>,
+    patch: &mut Vec<f32>,
 ) -> [f64; 5] {
     let n = b + 2;
     let (sx, sy) = (bx - 1.0 + dx, by - 1.0 + dy);
     let (fx, fy) = (sx.floor(), sy.floor());
-    let (ax, ay) = (sx - fx, sy - fy);
+    let (ax, ay) = ((sx - fx) as f32, (sy - fy) as f32);
     patch.clear();
     let inside = fx >= 0.0 && fy >= 0.0 && fx as usize + n < cur.width() && fy as usize + n < cur.height();
     if inside {
         let (ix, iy) = (fx as usize, fy as usize);
-        let (w00, w10, w01, w11) = ((1.0 - ax) * (1.0 - ay), ax * (1.0 - ay), (1.0 - ax) * ay, ax * ay);
-        for j in 0..n {
-            let (r0, r1) = (&cur.row(iy + j)[ix..ix + n + 1], &cur.row(iy + j + 1)[ix..ix + n + 1]);
-            for i in 0..n {
-                patch.push(w00 * r0[i] as f64 + w10 * r0[i + 1] as f64 + w01 * r1[i] as f64 + w11 * r1[i + 1] as f64);
+        if ax == 0.0 && ay == 0.0 {
+            // An integer offset (the first step): a plain copy.
+            for j in 0..n {
+                patch.extend(cur.row(iy + j)[ix..ix + n].iter().map(|&v| v as f32));
+            }
+        } else {
+            let (w00, w10, w01, w11) = ((1.0 - ax) * (1.0 - ay), ax * (1.0 - ay), (1.0 - ax) * ay, ax * ay);
+            for j in 0..n {
+                let (r0, r1) = (&cur.row(iy + j)[ix..ix + n + 1], &cur.row(iy + j + 1)[ix..ix + n + 1]);
+                for i in 0..n {
+                    patch.push(
+                        w00 * r0[i] as f32 + w10 * r0[i + 1] as f32 + w01 * r1[i] as f32 + w11 * r1[i + 1] as f32,
+                    );
+                }
             }
         }
     } else {
         for j in 0..n {
             for i in 0..n {
-                patch.push(at(cur, sx + i as f64, sy + j as f64));
+                patch.push(at(cur, sx + i as f64, sy + j as f64) as f32);
             }
         }
     }
+    let g = gain as f32;
     let mut s = [0.0f64; 5];
     for j in 1..=b {
         let prow = prev.row((by as usize + j - 1).min(prev.height() - 1));
+        let x0 = (bx as usize).min(prev.width() - b);
+        let prow = &prow[x0..x0 + b];
+        let (up, mid, down) =
+            (&patch[(j - 1) * n..j * n], &patch[j * n..(j + 1) * n], &patch[(j + 1) * n..(j + 2) * n]);
+        // One row's sums in f32 (at most 8 terms), accumulated in f64.
+        let mut r = [0.0f32; 5];
         for i in 1..=b {
-            let c = patch[j * n + i];
-            let gx = 0.5 * gain * (patch[j * n + i + 1] - patch[j * n + i - 1]);
-            let gy = 0.5 * gain * (patch[(j + 1) * n + i] - patch[(j - 1) * n + i]);
-            let e = gain * c - prow[(bx as usize + i - 1).min(prev.width() - 1)] as f64;
-            s[0] += gx * gx;
-            s[1] += gx * gy;
-            s[2] += gy * gy;
-            s[3] += gx * e;
-            s[4] += gy * e;
+            let gx = 0.5 * g * (mid[i + 1] - mid[i - 1]);
+            let gy = 0.5 * g * (down[i] - up[i]);
+            let e = g * mid[i] - prow[i - 1] as f32;
+            r[0] += gx * gx;
+            r[1] += gx * gy;
+            r[2] += gy * gy;
+            r[3] += gx * e;
+            r[4] += gy * e;
+        }
+        for k in 0..5 {
+            s[k] += r[k] as f64;
         }
     }
     s
