@@ -47,30 +47,28 @@ impl Default for BlockMatching {
     }
 }
 
-/// `cap + clamp(sobel_x, -cap, cap)` per pixel (borders replicated).
+/// `cap + clamp(sobel_x, -cap, cap)` per pixel (borders replicated). The result must fit a
+/// byte: caps above 127 are taken as 127.
 pub fn prefilter_xsobel(img: &Plane<u8>, cap: u8) -> Plane<u8> {
     let (w, h) = img.size();
-    let c = cap as i16;
+    let c = cap.min(127) as i16;
     let mut out = Plane::new(w, h);
-    // Row by row: the vertical [1 2 1] of the horizontal differences, in i16 over padded rows.
-    let mut diff = [vec![0i16; w], vec![0i16; w], vec![0i16; w]];
-    let row_diff = |y: usize, d: &mut Vec<i16>| {
+    // The horizontal difference of every row once, then the vertical [1 2 1] of them.
+    let mut diff = vec![0i16; w * h];
+    for (y, d) in diff.chunks_exact_mut(w).enumerate() {
         let r = img.row(y);
         if w == 1 {
-            d[0] = 0;
-            return;
+            continue;
         }
         d[0] = r[1] as i16 - r[0] as i16;
         d[w - 1] = r[w - 1] as i16 - r[w - 2] as i16;
         for ((o, &a), &b) in d[1..w - 1].iter_mut().zip(&r[2..]).zip(&r[..w - 2]) {
             *o = a as i16 - b as i16;
         }
-    };
+    }
+    let row = |y: usize| &diff[y * w..(y + 1) * w];
     for y in 0..h {
-        for (k, dy) in [-1isize, 0, 1].into_iter().enumerate() {
-            row_diff((y as isize + dy).clamp(0, h as isize - 1) as usize, &mut diff[k]);
-        }
-        let [up, mid, down] = &diff;
+        let (up, mid, down) = (row(y.saturating_sub(1)), row(y), row((y + 1).min(h - 1)));
         for (((o, &a), &b), &cc) in out.row_mut(y).iter_mut().zip(up).zip(mid).zip(down) {
             *o = ((a + 2 * b + cc).clamp(-c, c) + c) as u8;
         }
@@ -81,15 +79,20 @@ pub fn prefilter_xsobel(img: &Plane<u8>, cap: u8) -> Plane<u8> {
 /// Disparity of the left image: pixels, NaN where invalid.
 pub fn block_match(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Result<Plane<f32>> {
     match p.prefilter_cap {
+        // The prefiltered values are 0..=2 cap and must fit a byte.
+        Some(cap) if cap == 0 || cap > 127 => {
+            Err(GeometryError::Invalid(format!("prefilter cap {cap} must be 1..=127")))
+        }
         Some(cap) if left.size() == right.size() => {
             let (l, r) = (prefilter_xsobel(left, cap), prefilter_xsobel(right, cap));
-            block_match_raw(&l, &r, p)
+            block_match_raw(&l, &r, p, 2 * cap as usize)
         }
-        _ => block_match_raw(left, right, p),
+        _ => block_match_raw(left, right, p, u8::MAX as usize),
     }
 }
 
-fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Result<Plane<f32>> {
+/// `top`: the largest value the images can hold (for the 16-bit cost bound).
+fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, top: usize) -> Result<Plane<f32>> {
     if left.size() != right.size() {
         return Err(GeometryError::Invalid(format!(
             "left image is {}x{}, right image {}x{}",
@@ -110,7 +113,6 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
         return Err(GeometryError::Invalid(format!("image {w}x{h} smaller than the {0}x{0} block", p.block)));
     }
     // Costs are u16: the largest window sum must fit.
-    let top = left.rows().chain(right.rows()).map(|r| r.iter().copied().max().unwrap_or(0)).max().unwrap_or(0) as usize;
     if p.block * p.block * top > u16::MAX as usize - 1 {
         return Err(GeometryError::Invalid(format!(
             "block {0}x{0} with grey values up to {top} overflows 16-bit costs: use a smaller block or the prefilter",
@@ -306,6 +308,7 @@ mod tests {
         let a = Plane::new(20, 20);
         assert!(block_match(&a, &Plane::new(21, 20), &BlockMatching::default()).is_err());
         assert!(block_match(&a, &a, &BlockMatching { block: 4, ..Default::default() }).is_err());
+        assert!(block_match(&a, &a, &BlockMatching { prefilter_cap: Some(200), ..Default::default() }).is_err());
         assert!(block_match(&Plane::new(5, 5), &Plane::new(5, 5), &BlockMatching::default()).is_err());
         // A flat pair has no unique match anywhere: all invalid, no panic.
         let flat = block_match(&a, &a, &BlockMatching { max_disparity: 8, ..Default::default() }).unwrap();

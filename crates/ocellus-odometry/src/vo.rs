@@ -157,80 +157,76 @@ impl VisualOdometry {
         if self.cfg.mode == Mode::Robust {
             return self.step_robust(&prev, frame);
         }
-        let s = self.cfg.process_sigma;
-        let mut p_pred = self.p + Matrix3::from_diagonal(&Vector3::new(s[0] * s[0], s[1] * s[1], s[2] * s[2]));
         let (flows, failure) = match group_flows(&prev, frame, &self.cfg.flow) {
             Ok(f) => (f, None),
             Err(OdometryError::NoTexture(why)) => (Vec::new(), Some(why)),
             Err(e) => return Err(e),
         };
-        if !flows.is_empty() {
-            let k = self.cfg.focal_px / self.cfg.height_m;
-            let w = 1.0 / (self.cfg.flow_sigma_px * self.cfg.flow_sigma_px);
-            let info_prior = p_pred.try_inverse().unwrap_or_else(Matrix3::zeros);
-            let mut info = info_prior;
-            let mut vec = info_prior * self.x;
-            for f in &flows {
-                let h1 = Vector3::new(k, 0.0, -f.v);
-                let h2 = Vector3::new(0.0, k, f.u);
-                info += (h1 * h1.transpose() + h2 * h2.transpose()) * w;
-                vec += (h1 * f.du + h2 * f.dv) * w;
-            }
-            match info.try_inverse() {
-                Some(cov) => {
-                    self.x = cov * vec;
-                    p_pred = cov;
-                }
-                None => return Err(OdometryError::NoTexture("the flow does not determine the motion".into())),
-            }
+        // The 72 flow components with the image Jacobian rows of each point.
+        let k = self.cfg.focal_px / self.cfg.height_m;
+        let w = 1.0 / (self.cfg.flow_sigma_px * self.cfg.flow_sigma_px);
+        let (mut info_z, mut b) = (Matrix3::zeros(), Vector3::zeros());
+        for f in &flows {
+            let h1 = Vector3::new(k, 0.0, -f.v);
+            let h2 = Vector3::new(0.0, k, f.u);
+            info_z += (h1 * h1.transpose() + h2 * h2.transpose()) * w;
+            b += (h1 * f.du + h2 * f.dv) * w;
         }
-        self.p = p_pred;
+        self.update(!flows.is_empty(), &info_z, &b)?;
         let (cam_right, cam_forward, turn) = (-self.x[0], self.x[1], -self.x[2]);
         let (r, f, t) = robot_motion(cam_right, cam_forward, turn, &self.cfg.mount);
         self.pose = self.pose.step(r, f, t);
-        Ok(OdometryStep {
+        Ok(self.output(flows, failure))
+    }
+
+    /// The filter's predict and (when `measured`) information-form update with the
+    /// measurement's information `info_z` and information vector `b` (`H^T R^-1 z`).
+    fn update(&mut self, measured: bool, info_z: &Matrix3<f64>, b: &Vector3<f64>) -> Result<()> {
+        let s = self.cfg.process_sigma;
+        let p_pred = self.p + Matrix3::from_diagonal(&Vector3::new(s[0] * s[0], s[1] * s[1], s[2] * s[2]));
+        if !measured {
+            self.p = p_pred;
+            return Ok(());
+        }
+        let info_prior = p_pred.try_inverse().unwrap_or_else(Matrix3::zeros);
+        let cov = (info_prior + info_z)
+            .try_inverse()
+            .ok_or_else(|| OdometryError::NoTexture("the flow does not determine the motion".into()))?;
+        self.x = cov * (info_prior * self.x + b);
+        self.p = cov;
+        Ok(())
+    }
+
+    /// The step's report from the current state.
+    fn output(&self, flows: Vec<FlowPoint>, failure: Option<String>) -> OdometryStep {
+        OdometryStep {
             pose: self.pose,
-            camera_motion: [cam_right, cam_forward, turn],
+            camera_motion: [-self.x[0], self.x[1], -self.x[2]],
             camera_motion_sigma: self.sigma(),
             flows,
             failure,
-        })
+        }
     }
 
     fn step_robust(&mut self, prev: &Plane<u8>, frame: &Plane<u8>) -> Result<OdometryStep> {
-        let s = self.cfg.process_sigma;
-        let mut p_pred = self.p + Matrix3::from_diagonal(&Vector3::new(s[0] * s[0], s[1] * s[1], s[2] * s[2]));
         let scale = self.cfg.height_m / self.cfg.focal_px;
         let fit = window_measurements(prev, frame, &self.cfg.robust)
             .and_then(|m| fit_rigid(&m, &self.cfg.robust).map(|f| (f, m)));
-        let (flows, failure) = match fit {
+        let (flows, failure, info_z, b) = match fit {
             Ok((f, m)) => {
                 // State (Tx, Ty, wz) = M (right_px, forward_px, turn), M = diag(-s, s, -1).
                 let z = Vector3::new(-scale * f.right_px, scale * f.forward_px, -f.turn_rad);
                 let m_inv = Matrix3::from_diagonal(&Vector3::new(-1.0 / scale, 1.0 / scale, -1.0));
                 let info_z = m_inv.transpose() * f.info * m_inv;
-                let info_prior = p_pred.try_inverse().unwrap_or_else(Matrix3::zeros);
-                let info = info_prior + info_z;
-                let cov = info
-                    .try_inverse()
-                    .ok_or_else(|| OdometryError::NoTexture("the flow does not determine the motion".into()))?;
-                self.x = cov * (info_prior * self.x + info_z * z);
-                p_pred = cov;
                 let flows = m.iter().map(|w| FlowPoint { u: w.u, v: w.v, du: w.du, dv: w.dv, inliers: 1 }).collect();
-                (flows, None)
+                (flows, None, info_z, info_z * z)
             }
-            Err(OdometryError::NoTexture(why)) => (Vec::new(), Some(why)),
+            Err(OdometryError::NoTexture(why)) => (Vec::new(), Some(why), Matrix3::zeros(), Vector3::zeros()),
             Err(e) => return Err(e),
         };
-        self.p = p_pred;
+        self.update(failure.is_none(), &info_z, &b)?;
         let (cam_right, cam_forward, turn) = (-self.x[0], self.x[1], -self.x[2]);
         self.pose = moved_by_camera(&self.pose, cam_right, cam_forward, turn, &self.cfg.mount);
-        Ok(OdometryStep {
-            pose: self.pose,
-            camera_motion: [cam_right, cam_forward, turn],
-            camera_motion_sigma: self.sigma(),
-            flows,
-            failure,
-        })
+        Ok(self.output(flows, failure))
     }
 }
