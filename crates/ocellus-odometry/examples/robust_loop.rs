@@ -8,8 +8,14 @@ use ocellus_synth::ground::{GroundConfig, GroundScene, GroundTexture};
 fn main() {
     let textures: [Plane<f32>; 3] = ["brick.png", "grass.png", "gravel.png"]
         .map(|n| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap().to_luma8().map(|v| v as f32));
-    let scene = GroundScene::new(GroundConfig { frames: 40, ..GroundConfig::easy(GroundTexture::Mosaic, 1) }, textures)
-        .unwrap();
+    // The texture as the first argument (brick, grass, gravel; mosaic by default).
+    let texture = match std::env::args().nth(1).as_deref() {
+        Some("brick") => GroundTexture::Brick,
+        Some("grass") => GroundTexture::Grass,
+        Some("gravel") => GroundTexture::Gravel,
+        _ => GroundTexture::Mosaic,
+    };
+    let scene = GroundScene::new(GroundConfig { frames: 40, ..GroundConfig::easy(texture, 1) }, textures).unwrap();
     let frames: Vec<Plane<u8>> = (0..scene.len()).map(|k| scene.frame(k).unwrap()).collect();
     let mut t = Vec::new();
     for _ in 0..25 {

@@ -75,6 +75,17 @@ fn at(img: &Plane<u8>, x: f64, y: f64) -> f64 {
     top + ay * (bot - top)
 }
 
+/// `x.floor()` without the library call that baseline x86-64 (no SSE4.1 `roundsd`) makes for
+/// it; exact for |x| < 2^52, which covers every pixel coordinate.
+fn floor(x: f64) -> f64 {
+    let t = x as i64 as f64;
+    if t > x {
+        t - 1.0
+    } else {
+        t
+    }
+}
+
 /// Mean grey level of the central `region` x `region` pixels, over every other row and
 /// column (40,000 samples for the defaults: plenty for a gain).
 fn region_mean(img: &Plane<u8>, region: usize) -> f64 {
@@ -110,10 +121,15 @@ fn lk_sums(
 ) -> [f64; 5] {
     let n = b + 2;
     let (sx, sy) = (bx - 1.0 + dx, by - 1.0 + dy);
-    let (fx, fy) = (sx.floor(), sy.floor());
+    let (fx, fy) = (floor(sx), floor(sy));
     let (ax, ay) = ((sx - fx) as f32, (sy - fy) as f32);
     patch.clear();
     let inside = fx >= 0.0 && fy >= 0.0 && fx as usize + n < cur.width() && fy as usize + n < cur.height();
+    if inside && b == 8 {
+        let mut p = [0.0f32; 100];
+        patch8(cur, fx as usize, fy as usize, ax, ay, &mut p);
+        return lk_sums8(prev, bx, by, &p, gain as f32);
+    }
     if inside {
         let (ix, iy) = (fx as usize, fy as usize);
         if ax == 0.0 && ay == 0.0 {
@@ -140,6 +156,9 @@ fn lk_sums(
         }
     }
     let g = gain as f32;
+    if b == 8 {
+        return lk_sums8(prev, bx, by, patch, g);
+    }
     let mut s = [0.0f64; 5];
     for j in 1..=b {
         let prow = prev.row((by as usize + j - 1).min(prev.height() - 1));
@@ -164,6 +183,59 @@ fn lk_sums(
         }
     }
     s
+}
+
+/// The 10x10 patch of `cur` (an 8x8 block and its border) whose top-left sample is at
+/// (ix + ax, iy + ay), bilinearly: each of the 11 source rows is interpolated along x once
+/// and shared by the two patch rows it touches, in fixed-size loops the compiler vectorizes.
+fn patch8(cur: &Plane<u8>, ix: usize, iy: usize, ax: f32, ay: f32, out: &mut [f32; 100]) {
+    const N: usize = 10;
+    let mut rows = [[0.0f32; N]; N + 1];
+    for (j, h) in rows.iter_mut().enumerate() {
+        let Some(src) = cur.row(iy + j).get(ix..ix + N + 1) else { continue };
+        let mut v = [0.0f32; N + 1];
+        for (d, &s) in v.iter_mut().zip(src) {
+            *d = s as f32;
+        }
+        for i in 0..N {
+            h[i] = v[i] + ax * (v[i + 1] - v[i]);
+        }
+    }
+    for j in 0..N {
+        let (t, b) = (&rows[j], &rows[j + 1]);
+        for i in 0..N {
+            out[j * N + i] = t[i] + ay * (b[i] - t[i]);
+        }
+    }
+}
+
+/// [`lk_sums`] for the default 8x8 block: the sums are kept per column in fixed 8-lane arrays,
+/// which the compiler turns into vector code, and reduced once at the end (64 terms in f32
+/// lose nothing that matters at grey-level precision).
+fn lk_sums8(prev: &Plane<u8>, bx: f64, by: f64, patch: &[f32], g: f32) -> [f64; 5] {
+    const B: usize = 8;
+    const N: usize = B + 2;
+    let mut acc = [[0.0f32; B]; 5];
+    let x0 = (bx as usize).min(prev.width() - B);
+    for j in 1..=B {
+        let prow = &prev.row((by as usize + j - 1).min(prev.height() - 1))[x0..x0 + B];
+        let (Some(up), Some(mid), Some(down)) =
+            (patch.get((j - 1) * N..j * N), patch.get(j * N..(j + 1) * N), patch.get((j + 1) * N..(j + 2) * N))
+        else {
+            break;
+        };
+        for i in 0..B {
+            let gx = 0.5 * g * (mid[i + 2] - mid[i]);
+            let gy = 0.5 * g * (down[i + 1] - up[i + 1]);
+            let e = g * mid[i + 1] - prow[i] as f32;
+            acc[0][i] += gx * gx;
+            acc[1][i] += gx * gy;
+            acc[2][i] += gy * gy;
+            acc[3][i] += gx * e;
+            acc[4][i] += gy * e;
+        }
+    }
+    acc.map(|lanes| lanes.iter().map(|&v| v as f64).sum())
 }
 
 /// Sub-pixel flows of all textured windows between `prev` and `cur`.
@@ -241,8 +313,12 @@ pub struct RigidMotion {
 /// camera height changing: the model has no use for it, but fitting it keeps the radial flow
 /// it causes out of the other three), and its derivatives by (r, f, w, k).
 fn predict(u: f64, v: f64, p: &Vector4<f64>) -> ([f64; 2], [[f64; 4]; 2]) {
-    let (r, f, w, k) = (p[0], p[1], p[2], p[3]);
-    let (s, c) = w.sin_cos();
+    predict_with(u, v, p, p[2].sin_cos())
+}
+
+/// [`predict`] with the sine and cosine of the turn given (they are the same for every window).
+fn predict_with(u: f64, v: f64, p: &Vector4<f64>, (s, c): (f64, f64)) -> ([f64; 2], [[f64; 4]; 2]) {
+    let (r, f, k) = (p[0], p[1], p[3]);
     let (a, b) = (u - r, v + f);
     let (ru, rv) = (a * c + b * s, -a * s + b * c);
     let m = 1.0 + k;
@@ -266,11 +342,12 @@ pub fn fit_rigid(meas: &[WindowMeasurement], cfg: &RobustConfig) -> Result<Rigid
         for _ in 0..8 {
             let mut a = Matrix4::zeros();
             let mut g = Vector4::zeros();
+            let sc = p[2].sin_cos();
             for (m, &k) in meas.iter().zip(&keep) {
                 if !k {
                     continue;
                 }
-                let (pred, j) = predict(m.u, m.v, &p);
+                let (pred, j) = predict_with(m.u, m.v, &p, sc);
                 let e = [m.u + m.du - pred[0], m.v + m.dv - pred[1]];
                 let w = &m.info;
                 // Cauchy weight on the residual's Mahalanobis length in pixels.
@@ -300,7 +377,8 @@ pub fn fit_rigid(meas: &[WindowMeasurement], cfg: &RobustConfig) -> Result<Rigid
                 * g;
             p += step;
             info = a;
-            if step.norm() < 1e-6 {
+            // 1e-5 px (or rad) is far below what the flows resolve.
+            if step.norm() < 1e-5 {
                 break;
             }
         }
