@@ -1,0 +1,136 @@
+//! Vergence (SPEC 4.3): the horizontal disparity at the gaze point of a rectified stereo
+//! pair, for binocular tracking (turn the eyes until the disparity at the fovea is 0).
+//!
+//! The left eye's cortical image at the gaze point is compared with the right eye's at every
+//! candidate position `gaze - (d, 0)`, by the zero-mean normalized correlation of the cells.
+//! Cells are dense at the fovea and sparse outside, so the comparison weighs the fixated
+//! surface most and its surroundings less, the way a foveal correlation window should. The
+//! best integer disparity is refined by a parabola through its neighbours' scores.
+//!
+//! Disparity is `x_left - x_right`, pixels (SPEC 5.4), positive for points in front of
+//! infinity on a rectified pair.
+
+use crate::logpolar::{LogPolarConfig, LogPolarMap, Scratch};
+use crate::{FoveaError, Result};
+use ocellus_image::Plane;
+
+/// Parameters of the vergence search.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct VergenceOptions {
+    /// Log rings.
+    pub rings: usize,
+    /// Sectors.
+    pub sectors: usize,
+    /// Fovea radius, pixels.
+    pub fovea_radius: f64,
+    /// Outer radius of the compared field, pixels.
+    pub max_radius: f64,
+    /// Smallest disparity searched, pixels.
+    pub min_disparity: i64,
+    /// Largest disparity searched, pixels.
+    pub max_disparity: i64,
+}
+
+impl Default for VergenceOptions {
+    /// 24 rings x 48 sectors between 2 and 24 px, disparities 0..=64 px.
+    fn default() -> Self {
+        Self { rings: 24, sectors: 48, fovea_radius: 2.0, max_radius: 24.0, min_disparity: 0, max_disparity: 64 }
+    }
+}
+
+/// A vergence estimate.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Vergence {
+    /// Disparity at the gaze point, pixels (`x_left - x_right`).
+    pub disparity_px: f64,
+    /// Normalized correlation at the best integer disparity (1: identical).
+    pub score: f64,
+}
+
+fn ncc(a: &Plane<f32>, b: &Plane<f32>) -> f64 {
+    let n = (a.width() * a.height()) as f64;
+    let (ma, mb) = (a.sum() / n, b.sum() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0f64, 0.0f64, 0.0f64);
+    for (ra, rb) in a.rows().zip(b.rows()) {
+        for (&x, &y) in ra.iter().zip(rb) {
+            let (x, y) = (x as f64 - ma, y as f64 - mb);
+            sab += x * y;
+            saa += x * x;
+            sbb += y * y;
+        }
+    }
+    if saa <= 0.0 || sbb <= 0.0 {
+        0.0
+    } else {
+        sab / (saa * sbb).sqrt()
+    }
+}
+
+/// The disparity at `gaze` (x, y in the left image, pixel centres at integers).
+pub fn vergence(left: &Plane<u8>, right: &Plane<u8>, gaze: [f64; 2], opts: &VergenceOptions) -> Result<Vergence> {
+    if left.size() != right.size() {
+        return Err(FoveaError::Size {
+            got_w: right.width(),
+            got_h: right.height(),
+            want_w: left.width(),
+            want_h: left.height(),
+        });
+    }
+    if opts.min_disparity > opts.max_disparity || opts.max_disparity - opts.min_disparity > 100_000 {
+        return Err(FoveaError::Invalid(format!("disparity range {}..={}", opts.min_disparity, opts.max_disparity)));
+    }
+    let (w, h) = left.size();
+    let [gx, gy] = gaze;
+    if !(gx.is_finite() && gy.is_finite() && gx >= 0.0 && gy >= 0.0 && gx <= (w - 1) as f64 && gy <= (h - 1) as f64) {
+        return Err(FoveaError::Invalid(format!("gaze point ({gx}, {gy}) outside the {w}x{h} image")));
+    }
+    let (gx, gy) = (gx.round(), gy.round());
+    let cfg = LogPolarConfig {
+        rings: opts.rings,
+        sectors: opts.sectors,
+        fovea_rings: opts.fovea_radius.round().max(1.0) as usize,
+        fovea_radius: opts.fovea_radius,
+        max_radius: opts.max_radius,
+        centre: [gx, gy],
+        max_level: 0,
+        min_field_texels: 1.0,
+    };
+    let map = LogPolarMap::new(&cfg, w, h)?;
+    let mut scratch = Scratch::default();
+    let mut lcortex = Plane::default();
+    map.sample_grey_into(left, &mut scratch, &mut lcortex)?;
+    let mut rcortex = Plane::default();
+    let mut scores = Vec::with_capacity((opts.max_disparity - opts.min_disparity + 1) as usize);
+    for d in opts.min_disparity..=opts.max_disparity {
+        let rx = gx - d as f64;
+        if rx < 0.0 || rx > (w - 1) as f64 {
+            scores.push(f64::NEG_INFINITY);
+            continue;
+        }
+        let moved = match map.shifted(-d, 0) {
+            Some(m) => m,
+            None => LogPolarMap::new(&LogPolarConfig { centre: [rx, gy], ..cfg }, w, h)?,
+        };
+        moved.sample_grey_into(right, &mut scratch, &mut rcortex)?;
+        scores.push(ncc(&lcortex, &rcortex));
+    }
+    let (mut bi, mut best) = (usize::MAX, f64::NEG_INFINITY);
+    for (i, &s) in scores.iter().enumerate() {
+        if s > best {
+            best = s;
+            bi = i;
+        }
+    }
+    if bi == usize::MAX || best <= 0.0 {
+        return Err(FoveaError::NoEstimate(format!("no match for the gaze point ({gx}, {gy}) in the disparity range")));
+    }
+    let mut d = opts.min_disparity as f64 + bi as f64;
+    if bi > 0 && bi + 1 < scores.len() && scores[bi - 1].is_finite() && scores[bi + 1].is_finite() {
+        let (l, c, r) = (scores[bi - 1], scores[bi], scores[bi + 1]);
+        let den = l - 2.0 * c + r;
+        if den < 0.0 {
+            d += (0.5 * (l - r) / den).clamp(-0.5, 0.5);
+        }
+    }
+    Ok(Vergence { disparity_px: d, score: best })
+}
