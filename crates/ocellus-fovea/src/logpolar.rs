@@ -48,12 +48,27 @@ pub struct LogPolarConfig {
     /// Least texels across a field's smaller side when choosing its pyramid level (>= 1;
     /// larger is sharper and slower).
     pub min_field_texels: f64,
+    /// The shape of the receptive fields.
+    pub fields: Fields,
+}
+
+/// The shape of the receptive fields.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Fields {
+    /// Each cell averages the bilinear image over exactly its annular sector (about 6-13
+    /// table entries per cell): the most faithful, for analysis.
+    Area,
+    /// Each cell reads the box pyramid level whose texels are as large as the cell, with one
+    /// bilinear sample at the cell's centroid: an overlapping, smooth field of about the
+    /// cell's size (box of the level convolved with a tent), exactly 4 table entries per cell.
+    /// The fast default (mipmapping, Williams 1983).
+    Pyramid,
 }
 
 impl LogPolarConfig {
     /// 128 rings x 128 sectors about the image centre, rho_max half the smaller side,
     /// rho_0 = rho_max / 60 (at least 2 px), one fovea ring per pixel of rho_0, pyramid up to
-    /// level 3, fields at least 2 texels across.
+    /// level 4, [`Fields::Pyramid`] fields one texel across.
     pub fn for_image(width: usize, height: usize) -> Self {
         let max_radius = (width.min(height) as f64 / 2.0).max(2.0);
         let fovea_radius = (max_radius / 60.0).max(2.0).min(max_radius / 2.0);
@@ -64,8 +79,9 @@ impl LogPolarConfig {
             fovea_radius,
             max_radius,
             centre: [(width as f64 - 1.0) / 2.0, (height as f64 - 1.0) / 2.0],
-            max_level: 3,
-            min_field_texels: 2.0,
+            max_level: 4,
+            min_field_texels: 1.0,
+            fields: Fields::Pyramid,
         }
     }
 
@@ -108,6 +124,7 @@ impl LogPolarConfig {
 #[derive(Clone, Debug, Default)]
 pub struct Scratch {
     pyramid: Vec<f32>,
+    row: Vec<f32>,
 }
 
 /// A log-polar map for one image size and one gaze point: the sparse weight table and what
@@ -125,10 +142,17 @@ pub struct LogPolarMap {
     /// Texel index: `y * width + x` at level 0; the pyramid buffer index above.
     offset: Vec<u32>,
     weight: Vec<f32>,
+    /// [`Fields::Pyramid`] cells: index of the top-left texel of the bilinear quad and the
+    /// fractions (fx, fy) towards the next column and row.
+    quad_base: Vec<u32>,
+    quad_frac: Vec<[f32; 2]>,
     coverage: Vec<f32>,
     /// Start of each level in the pyramid buffer (in texels), levels 1..=levels.
     level_base: Vec<usize>,
     levels: usize,
+    /// Level-0 pixel rectangle [x0, y0, x1, y1) the pyramid levels are computed over
+    /// (what the fields read, aligned to the coarsest level).
+    pyramid_rect: [usize; 4],
 }
 
 /// Size of pyramid level `l` of a `w` x `h` image (level 0 is the image).
@@ -169,9 +193,12 @@ impl LogPolarMap {
             level: Vec::with_capacity(cells),
             offset: Vec::new(),
             weight: Vec::new(),
+            quad_base: Vec::new(),
+            quad_frac: Vec::new(),
             coverage: Vec::with_capacity(cells),
             level_base,
             levels: 0,
+            pyramid_rect: [0, 0, 0, 0],
         };
         map.start.push(0);
         let mut acc: Vec<(u32, f32)> = Vec::new();
@@ -193,6 +220,10 @@ impl LogPolarMap {
             let half = (t - 1.0) / 2.0;
             for sector in 0..cfg.sectors {
                 acc.clear();
+                if cfg.fields == Fields::Pyramid {
+                    map.push_centroid_cell(row, sector, l, lw, lh);
+                    continue;
+                }
                 let t0 = sector as f64 * dt;
                 let (mut inside, mut all) = (0.0f64, 0.0f64);
                 for m in 0..nr {
@@ -244,7 +275,50 @@ impl LogPolarMap {
                 }
             }
         }
+        map.pyramid_rect = map.rect_read();
         Ok(map)
+    }
+
+    /// The level-0 rectangle covering every pyramid texel the table reads, aligned to the
+    /// coarsest level used.
+    fn rect_read(&self) -> [usize; 4] {
+        if self.levels == 0 {
+            return [0, 0, 0, 0];
+        }
+        let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+        for c in 0..self.level.len() {
+            let l = self.level[c] as usize;
+            if l == 0 {
+                continue;
+            }
+            let (lw, _) = level_size(self.width, self.height, l);
+            for &o in &self.offset[self.start[c] as usize..self.start[c + 1] as usize] {
+                let i = o as usize - self.level_base[l];
+                let (x, y) = (i % lw, i / lw);
+                x0 = x0.min(x << l);
+                y0 = y0.min(y << l);
+                x1 = x1.max((x + 1) << l);
+                y1 = y1.max((y + 1) << l);
+            }
+        }
+        for (&b, &l) in self.quad_base.iter().zip(&self.level) {
+            let l = l as usize;
+            if l == 0 || b == u32::MAX {
+                continue;
+            }
+            let (lw, _) = level_size(self.width, self.height, l);
+            let i = b as usize - self.level_base[l];
+            let (x, y) = (i % lw, i / lw);
+            x0 = x0.min(x << l);
+            y0 = y0.min(y << l);
+            x1 = x1.max((x + 2) << l);
+            y1 = y1.max((y + 2) << l);
+        }
+        if x0 == usize::MAX {
+            return [0, 0, 0, 0];
+        }
+        let a = 1usize << self.levels;
+        [x0 / a * a, y0 / a * a, x1.div_ceil(a) * a, y1.div_ceil(a) * a]
     }
 
     /// The same map with the gaze point moved by whole pixels (dx, dy), without rebuilding
@@ -267,7 +341,44 @@ impl LogPolarMap {
         for o in out.offset.iter_mut() {
             *o = (*o as i64 + delta) as u32;
         }
+        for o in out.quad_base.iter_mut().filter(|o| **o != u32::MAX) {
+            *o = (*o as i64 + delta) as u32;
+        }
         Some(out)
+    }
+
+    /// A [`Fields::Pyramid`] cell: one bilinear sample of level `l` (`lw` x `lh` texels) at
+    /// the centroid of the cell's annular sector (radius `2/3 (r1^3 - r0^3) / (r1^2 - r0^2)
+    /// sinc(dt / 2)` along the middle angle).
+    fn push_centroid_cell(&mut self, row: usize, sector: usize, l: usize, lw: usize, lh: usize) {
+        let (r0, r1) = self.row_radii(row);
+        let dt = TAU / self.cfg.sectors as f64;
+        let rc = if r1 > r0 { 2.0 / 3.0 * (r1.powi(3) - r0.powi(3)) / (r1 * r1 - r0 * r0) } else { r0 };
+        let rc = rc * (dt / 2.0).sin() / (dt / 2.0);
+        let (s, c) = self.sector_angle(sector).sin_cos();
+        let t = (1usize << l) as f64;
+        let half = (t - 1.0) / 2.0;
+        let x = (self.cfg.centre[0] + rc * c - half) / t;
+        let y = (self.cfg.centre[1] + rc * s - half) / t;
+        // Texels beyond the level's edge are read as the edge (clamped), so that a cell half
+        // off the image still gets a value; cells whose centroid is off the image get none.
+        let base = if l == 0 { 0 } else { self.level_base[l] };
+        let inside = x > -0.5 && y > -0.5 && x < lw as f64 - 0.5 && y < lh as f64 - 0.5 && lw >= 2 && lh >= 2;
+        if inside {
+            // The quad's top-left texel stays one short of the last row and column, so that
+            // the quad is always 2x2 inside the level (the fraction may then reach 1).
+            let (xc, yc) = (x.clamp(0.0, (lw - 1) as f64), y.clamp(0.0, (lh - 1) as f64));
+            let (x0, y0) = ((xc.floor() as usize).min(lw - 2), (yc.floor() as usize).min(lh - 2));
+            self.quad_base.push((base + y0 * lw + x0) as u32);
+            self.quad_frac.push([(xc - x0 as f64) as f32, (yc - y0 as f64) as f32]);
+            self.levels = self.levels.max(l);
+        } else {
+            self.quad_base.push(u32::MAX);
+            self.quad_frac.push([0.0, 0.0]);
+        }
+        self.start.push(self.offset.len() as u32);
+        self.level.push(l as u8);
+        self.coverage.push(if inside { 1.0 } else { 0.0 });
     }
 
     /// The configuration.
@@ -320,7 +431,7 @@ impl LogPolarMap {
 
     /// Entries of the weight table (the per-frame work, in texel reads per channel).
     pub fn table_entries(&self) -> usize {
-        self.offset.len()
+        self.offset.len() + 4 * self.quad_base.len()
     }
 
     fn check_size(&self, w: usize, h: usize) -> Result<()> {
@@ -381,24 +492,37 @@ impl LogPolarMap {
 
     /// Builds the box pyramid (means of 2^l x 2^l pixels) of `src` (C interleaved channels)
     /// up to the coarsest level a field reads, then applies the table.
-    fn apply<T: Copy + Into<f32>, const C: usize>(&self, src: &[T], scratch: &mut Scratch, out: &mut [f32]) {
+    fn apply<T: Texel, const C: usize>(&self, src: &[T], scratch: &mut Scratch, out: &mut [f32]) {
         let top = self.levels;
         if top > 0 {
-            let total = self.level_base.get(top).copied().unwrap_or(0)
-                + level_size(self.width, self.height, top).0 * level_size(self.width, self.height, top).1;
-            scratch.pyramid.resize(total * C, 0.0);
             let (w, h) = (self.width, self.height);
-            let (lw, lh) = level_size(w, h, 1);
-            halve_first::<T, C>(src, w, &mut scratch.pyramid[..lw * lh * C], lw, lh);
-            for l in 2..=top {
-                let (pw, ph) = level_size(w, h, l - 1);
+            let total = self.level_base[top] + level_size(w, h, top).0 * level_size(w, h, top).1;
+            scratch.pyramid.resize(total * C, 0.0);
+            let [rx0, ry0, rx1, ry1] = self.pyramid_rect;
+            for l in 1..=top {
+                let (pw, _) = level_size(w, h, l - 1);
                 let (lw, lh) = level_size(w, h, l);
+                // Texels of level l inside the rectangle.
+                let (tx0, ty0) = (rx0 >> l, ry0 >> l);
+                let (tx1, ty1) = ((rx1 >> l).min(lw), (ry1 >> l).min(lh));
+                if tx1 <= tx0 || ty1 <= ty0 {
+                    continue;
+                }
                 let (lo, hi) = scratch.pyramid.split_at_mut(self.level_base[l] * C);
-                let prev = &lo[self.level_base[l - 1] * C..(self.level_base[l - 1] + pw * ph) * C];
-                halve_next::<C>(prev, pw, &mut hi[..lw * lh * C], lw, lh);
+                let dst = &mut hi[..lw * lh * C];
+                if l == 1 {
+                    halve::<T, C>(src, pw, dst, lw, [tx0, ty0, tx1, ty1], &mut scratch.row);
+                } else {
+                    let prev = &lo[self.level_base[l - 1] * C..];
+                    halve::<f32, C>(prev, pw, dst, lw, [tx0, ty0, tx1, ty1], &mut scratch.row);
+                }
             }
         }
         let pyr = &scratch.pyramid;
+        if self.cfg.fields == Fields::Pyramid {
+            self.apply_quads::<T, C>(src, pyr, out);
+            return;
+        }
         for (c, o) in out.chunks_exact_mut(C).enumerate() {
             let (s, e) = (self.start[c] as usize, self.start[c + 1] as usize);
             let (offs, ws) = (&self.offset[s..e], &self.weight[s..e]);
@@ -419,6 +543,30 @@ impl LogPolarMap {
                 }
             }
             o.copy_from_slice(&acc);
+        }
+    }
+
+    /// The [`Fields::Pyramid`] table: one bilinear quad per cell.
+    fn apply_quads<T: Texel, const C: usize>(&self, src: &[T], pyr: &[f32], out: &mut [f32]) {
+        let row_step: Vec<usize> = (0..=self.levels).map(|l| level_size(self.width, self.height, l).0 * C).collect();
+        for (((o, &b), &[fx, fy]), &l) in
+            out.chunks_exact_mut(C).zip(&self.quad_base).zip(&self.quad_frac).zip(&self.level)
+        {
+            if b == u32::MAX {
+                o.fill(0.0);
+                continue;
+            }
+            let (i, dy) = (b as usize * C, row_step.get(l as usize).copied().unwrap_or(0));
+            for ch in 0..C {
+                let (p00, p01, p10, p11) = if l == 0 {
+                    (src[i + ch].into(), src[i + C + ch].into(), src[i + dy + ch].into(), src[i + dy + C + ch].into())
+                } else {
+                    (pyr[i + ch], pyr[i + C + ch], pyr[i + dy + ch], pyr[i + dy + C + ch])
+                };
+                let top = p00 + fx * (p01 - p00);
+                let bot = p10 + fx * (p11 - p10);
+                o[ch] = top + fy * (bot - top);
+            }
         }
     }
 
@@ -531,21 +679,54 @@ fn out_slice(out: &mut Plane<f32>) -> &mut [f32] {
     out.as_contiguous_mut().unwrap_or_default()
 }
 
-/// Level 1 of the box pyramid: means of 2x2 pixels of `src` (row length `w` pixels).
-fn halve_first<T: Copy + Into<f32>, const C: usize>(src: &[T], w: usize, dst: &mut [f32], lw: usize, lh: usize) {
-    for y in 0..lh {
-        let (r0, r1) = (&src[2 * y * w * C..(2 * y + 1) * w * C], &src[(2 * y + 1) * w * C..(2 * y + 2) * w * C]);
-        let d = &mut dst[y * lw * C..(y + 1) * lw * C];
-        for x in 0..lw {
-            for ch in 0..C {
-                let (i, j) = (2 * x * C + ch, (2 * x + 1) * C + ch);
-                d[x * C + ch] = 0.25 * ((r0[i].into() + r0[j].into()) + (r1[i].into() + r1[j].into()));
-            }
-        }
+/// Pixel types the pyramid reads: the sum of two is kept exactly in `Acc`.
+trait Texel: Copy + Into<f32> {
+    /// Pairwise sum type.
+    type Acc: Copy + std::ops::Add<Output = Self::Acc> + Into<f32>;
+    fn acc(self) -> Self::Acc;
+}
+
+impl Texel for u8 {
+    type Acc = u16;
+    #[inline(always)]
+    fn acc(self) -> u16 {
+        self as u16
     }
 }
 
-/// The next level of the box pyramid from the previous one (row length `pw` texels).
-fn halve_next<const C: usize>(src: &[f32], pw: usize, dst: &mut [f32], lw: usize, lh: usize) {
-    halve_first::<f32, C>(src, pw, dst, lw, lh)
+impl Texel for f32 {
+    type Acc = f32;
+    #[inline(always)]
+    fn acc(self) -> f32 {
+        self
+    }
+}
+
+/// One box-pyramid level: texels `rect` = [x0, y0, x1, y1) of `dst` (row length `lw`
+/// texels) become the means of 2x2 texels of `src` (row length `sw`), C interleaved channels.
+/// Row pairs are summed first (contiguous, vectorized), then column pairs.
+fn halve<T: Texel, const C: usize>(
+    src: &[T],
+    sw: usize,
+    dst: &mut [f32],
+    lw: usize,
+    rect: [usize; 4],
+    row: &mut Vec<f32>,
+) {
+    let [x0, y0, x1, y1] = rect;
+    let n = 2 * (x1 - x0) * C;
+    row.resize(n, 0.0);
+    for y in y0..y1 {
+        let a = &src[(2 * y * sw + 2 * x0) * C..][..n];
+        let b = &src[((2 * y + 1) * sw + 2 * x0) * C..][..n];
+        for ((r, &p), &q) in row.iter_mut().zip(a).zip(b) {
+            *r = (p.acc() + q.acc()).into();
+        }
+        let d = &mut dst[(y * lw + x0) * C..(y * lw + x1) * C];
+        for (o, pair) in d.chunks_exact_mut(C).zip(row.chunks_exact(2 * C)) {
+            for ch in 0..C {
+                o[ch] = 0.25 * (pair[ch] + pair[C + ch]);
+            }
+        }
+    }
 }

@@ -10,7 +10,7 @@
 //! Disparity is `x_left - x_right`, pixels (SPEC 5.4), positive for points in front of
 //! infinity on a rectified pair.
 
-use crate::logpolar::{LogPolarConfig, LogPolarMap, Scratch};
+use crate::logpolar::{Fields, LogPolarConfig, LogPolarMap, Scratch};
 use crate::{FoveaError, Result};
 use ocellus_image::Plane;
 
@@ -94,6 +94,7 @@ pub fn vergence(left: &Plane<u8>, right: &Plane<u8>, gaze: [f64; 2], opts: &Verg
         centre: [gx, gy],
         max_level: 0,
         min_field_texels: 1.0,
+        fields: Fields::Area,
     };
     let map = LogPolarMap::new(&cfg, w, h)?;
     let mut scratch = Scratch::default();
