@@ -23,6 +23,9 @@ pub enum Target {
     Geometry,
     /// Visual odometry per 640x480 frame on one core (seed mode), on generated floor frames.
     Odometry,
+    /// The log-polar map, 640x480 grey and RGB to 128 rings x 128 sectors on one core, and
+    /// the table construction.
+    Logpolar,
 }
 
 /// Arguments of `ocellus bench`.
@@ -179,6 +182,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         Target::Planning => return crate::bench_planning::run(a.json, a.frames.max(100)),
         Target::Geometry => return crate::bench_geometry::run(a.json, 5),
         Target::Odometry => return crate::bench_odometry::run(a.json),
+        Target::Logpolar => return crate::bench_logpolar::run(a.json),
         Target::Saliency => {}
     }
     let backend: Backend = serde_json::from_value(json!(a.backend))

@@ -5,6 +5,7 @@ mod attend;
 mod bench;
 mod bench_attention;
 mod bench_geometry;
+mod bench_logpolar;
 mod bench_odometry;
 mod bench_planning;
 mod calibrate_cmd;
@@ -19,6 +20,7 @@ mod generate;
 mod generate_chessboard;
 mod generate_ground;
 mod inputs;
+mod logpolar_cmd;
 mod odometry_cmd;
 mod overlay;
 mod plan_cmd;
@@ -72,6 +74,10 @@ enum Command {
     /// Kalman filter): a TUM trajectory, a plot and flow overlays; `odometry eval` scores a
     /// trajectory against ground truth.
     Odometry(odometry_cmd::OdometryArgs),
+    /// Foveal vision: the anti-aliased log-polar image of a picture about a gaze point and its
+    /// inverse; `logpolar register` estimates rotation and scale between two images;
+    /// `logpolar vergence` the disparity at a gaze point of a stereo pair.
+    Logpolar(logpolar_cmd::LogPolarArgs),
     /// Remove lens distortion from images with a calibrated camera file (same intrinsics).
     Undistort(undistort_cmd::UndistortArgs),
     /// 3D points from pixel matches in two or more calibrated cameras (camera JSON files of
@@ -111,6 +117,7 @@ fn main() {
         Command::Triangulate(a) => triangulate_cmd::run(a),
         Command::Undistort(a) => undistort_cmd::run(a),
         Command::Odometry(a) => odometry_cmd::run(a),
+        Command::Logpolar(a) => logpolar_cmd::run(a),
     };
     if let Err(e) = r {
         eprintln!("error: {e:#}");

@@ -730,3 +730,61 @@ fn halve<T: Texel, const C: usize>(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+        /// Any parameters: a clear error or a map whose outputs are finite and within the
+        /// input's range (fields are weighted means), for both field kinds.
+        #[test]
+        fn any_parameters_give_an_error_or_bounded_means(
+            w in 1usize..40, h in 1usize..40, rings in 0usize..20, sectors in 0usize..20, fovea_rings in 0usize..4,
+            rho0 in -2.0f64..10.0, rho_max in -1.0f64..40.0, cx in -20.0f64..60.0, cy in -20.0f64..60.0,
+            max_level in 0usize..6, area in any::<bool>(), seed in any::<u64>(),
+        ) {
+            let cfg = LogPolarConfig {
+                rings, sectors, fovea_rings, fovea_radius: rho0, max_radius: rho_max, centre: [cx, cy], max_level,
+                min_field_texels: 1.0, fields: if area { Fields::Area } else { Fields::Pyramid },
+            };
+            if let Ok(map) = LogPolarMap::new(&cfg, w, h) {
+                let mut rng = ocellus_image::rng::SplitMix64::new(seed);
+                let img = Plane::from_fn(w, h, |_, _| 50 + rng.below(100) as u8);
+                let out = map.sample_grey(&img).unwrap();
+                prop_assert_eq!(out.size(), (sectors, map.rows()));
+                for (v, cov) in out.rows().flatten().zip(map.coverage()) {
+                    prop_assert!(v.is_finite());
+                    // Cells that read the image see only values in 50..150.
+                    if *cov > 0.0 {
+                        prop_assert!((49.99..=150.01).contains(v), "{} (coverage {})", v, cov);
+                    }
+                }
+                let inv = map.inverse(&out).unwrap();
+                prop_assert!(inv.all_finite());
+            }
+        }
+    }
+
+    #[test]
+    fn a_quarter_turn_is_a_shift_by_a_quarter_of_the_sectors() {
+        // 32 = 2^5: the pyramid's texel grids are symmetric about the centre (15.5, 15.5) at
+        // every level, so pyramid fields turn with the image too (for other sizes they do up
+        // to the grid, as the 512x512 test on a real image shows).
+        let n = 32;
+        let img = Plane::from_fn(n, n, |x, y| ((x * 37 + y * 11 + x * y) % 200) as u8);
+        let quarter = Plane::from_fn(n, n, |x, y| img.get(y, n - 1 - x));
+        for fields in [Fields::Pyramid, Fields::Area] {
+            let cfg = LogPolarConfig { rings: 12, sectors: 16, fields, ..LogPolarConfig::for_image(n, n) };
+            let map = LogPolarMap::new(&cfg, n, n).unwrap();
+            let (a, b) = (map.sample_grey(&img).unwrap(), map.sample_grey(&quarter).unwrap());
+            for y in 0..map.rows() {
+                for x in 0..16 {
+                    assert!((b.get((x + 4) % 16, y) - a.get(x, y)).abs() < 1e-2, "{fields:?} row {y} sector {x}");
+                }
+            }
+        }
+    }
+}

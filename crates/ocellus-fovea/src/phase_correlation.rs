@@ -142,7 +142,7 @@ mod tests {
                 if kx == 0 && ky <= 0 {
                     continue;
                 }
-                waves.push((kx as f64, ky as f64, rng.unit() * 6.28, rng.unit() + 0.2));
+                waves.push((kx as f64, ky as f64, rng.unit() * std::f64::consts::TAU, rng.unit() + 0.2));
             }
         }
         let img = |sx: f64, sy: f64| {

@@ -156,7 +156,7 @@ fn area_fields_are_closer_to_a_supersampled_reference_than_point_sampling() {
 
 #[test]
 fn rotation_and_scale_are_recovered_from_real_images() {
-    let cases = [
+    let cases: [(f64, f64); 10] = [
         (0.0, 1.0),
         (12.5, 1.0),
         (33.0, 0.5),
@@ -172,7 +172,7 @@ fn rotation_and_scale_are_recovered_from_real_images() {
         let a = grey(name).map(|v| v as f32);
         let (mut angle_err, mut scale_err) = (0.0, 0.0);
         for &(deg, s) in &cases {
-            let b = warp(&a, (deg as f64).to_radians(), s);
+            let b = warp(&a, deg.to_radians(), s);
             let r = register(&a, &b, &RegisterOptions::default()).unwrap();
             let de =
                 (r.angle_deg - deg).abs().min((r.angle_deg - deg + 360.0).abs()).min((r.angle_deg - deg - 360.0).abs());

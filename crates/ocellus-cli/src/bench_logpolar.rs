@@ -1,0 +1,66 @@
+//! `ocellus bench logpolar`: the log-polar map per 640x480 frame on one core.
+
+use crate::bench::median;
+use anyhow::{Context, Result};
+use ocellus_fovea::logpolar::{Fields, LogPolarConfig, LogPolarMap, Scratch};
+use ocellus_image::Plane;
+use serde_json::json;
+use std::time::Instant;
+
+/// The built-in astronaut photo stretched to 640x480 (nearest pixel: the content only has
+/// to be a real image; the timing does not depend on it).
+fn frame() -> Result<Plane<[u8; 3]>> {
+    let (name, bytes) =
+        crate::assets::IMAGES.iter().find(|(n, _)| *n == "astronaut.png").context("built-in astronaut.png missing")?;
+    let src = ocellus_io::decode_image(bytes, std::path::Path::new(name))?.to_u8();
+    let (w, h) = src.size();
+    Ok(Plane::from_fn(640, 480, |x, y| src.get(x * w / 640, y * h / 480)))
+}
+
+/// Runs the benchmark: 128 log rings x 128 sectors (plus the fovea rings) about the centre.
+pub fn run(json_out: bool) -> Result<()> {
+    let rgb = frame()?;
+    let grey = rgb.map(|p| ((p[0] as u32 * 77 + p[1] as u32 * 150 + p[2] as u32 * 29 + 128) >> 8) as u8);
+    let mut figures = serde_json::Map::new();
+    for (name, fields) in [("pyramid", Fields::Pyramid), ("area", Fields::Area)] {
+        let cfg = LogPolarConfig { fields, ..LogPolarConfig::for_image(640, 480) };
+        let mut build = Vec::new();
+        let mut map = None;
+        for _ in 0..5 {
+            let t = Instant::now();
+            map = Some(LogPolarMap::new(&cfg, 640, 480)?);
+            build.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        let map = map.context("no map")?;
+        let mut scratch = Scratch::default();
+        let (mut out, mut out_rgb) = (Plane::default(), Vec::new());
+        let (mut tg, mut tc) = (Vec::new(), Vec::new());
+        for _ in 0..400 {
+            let t = Instant::now();
+            map.sample_grey_into(&grey, &mut scratch, &mut out)?;
+            tg.push(t.elapsed().as_secs_f64() * 1e6);
+            let t = Instant::now();
+            map.sample_rgb_into(&rgb, &mut scratch, &mut out_rgb)?;
+            tc.push(t.elapsed().as_secs_f64() * 1e6);
+        }
+        let suffix = if fields == Fields::Pyramid { String::new() } else { format!("_{name}") };
+        figures.insert(format!("us_per_frame_grey_1thread{suffix}"), json!(median(&mut tg)));
+        figures.insert(format!("us_per_frame_rgb_1thread{suffix}"), json!(median(&mut tc)));
+        figures.insert(format!("ms_table_build{suffix}"), json!(median(&mut build)));
+        figures.insert(format!("table_entries{suffix}"), json!(map.table_entries()));
+        if fields == Fields::Pyramid {
+            figures.insert("cells".into(), json!(map.rows() * map.sectors()));
+            figures.insert("compression_ratio".into(), json!(map.compression_ratio()));
+        }
+    }
+    let v = serde_json::Value::Object(figures);
+    if json_out {
+        println!("{v}");
+    } else {
+        println!("log-polar benchmark, 640x480 -> 128 log rings (+ fovea) x 128 sectors, one thread, medians:");
+        for (k, val) in v.as_object().into_iter().flatten() {
+            println!("  {k:<34} {:.4}", val.as_f64().unwrap_or(f64::NAN));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,218 @@
+//! `ocellus logpolar`: the log-polar (foveal) image of a picture and its inverse;
+//! `logpolar register A B`: rotation and scale between two images; `logpolar vergence L R`:
+//! disparity at a gaze point of a stereo pair.
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand, ValueEnum};
+use ocellus_fovea::logpolar::{Fields, LogPolarConfig, LogPolarMap};
+use ocellus_fovea::register::{register, Mode, RegisterOptions};
+use ocellus_fovea::vergence::{vergence, VergenceOptions};
+use ocellus_image::Plane;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `ocellus logpolar`.
+#[derive(Args, Debug)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct LogPolarArgs {
+    #[command(subcommand)]
+    sub: Option<Sub>,
+    /// Input image (PNG, JPEG, PNM; colour is kept).
+    #[arg(required = true)]
+    image: Option<PathBuf>,
+    /// Log rings between the fovea radius and the outer radius.
+    #[arg(long, default_value_t = 128)]
+    rings: usize,
+    /// Sectors over the full turn.
+    #[arg(long, default_value_t = 128)]
+    sectors: usize,
+    /// Gaze point `X,Y` in pixels (pixel centres at integers) [default: the image centre].
+    #[arg(long, value_parser = parse_point)]
+    fovea: Option<[f64; 2]>,
+    /// Fovea radius rho_0, pixels [default: outer radius / 60, at least 2].
+    #[arg(long)]
+    fovea_radius: Option<f64>,
+    /// Outer radius rho_max, pixels [default: half the image's smaller side].
+    #[arg(long)]
+    max_radius: Option<f64>,
+    /// Receptive fields: `pyramid` (fast, one bilinear read of the box-pyramid level as large
+    /// as the cell) or `area` (the exact mean over each cell's annular sector).
+    #[arg(long, value_enum, default_value = "pyramid")]
+    fields: FieldsArg,
+    /// Output folder: cortex.png (sectors across, rings down; fovea rings on top),
+    /// inverse.png (the cortical image mapped back for display), logpolar.json (geometry and
+    /// compression ratio).
+    #[arg(long, default_value = "ocellus-logpolar")]
+    out: PathBuf,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum FieldsArg {
+    Pyramid,
+    Area,
+}
+
+#[derive(Subcommand, Debug)]
+enum Sub {
+    /// Rotation (degrees, clockwise on the screen) and scale of image B relative to image A,
+    /// by phase correlation of their log-polar images.
+    Register(RegisterArgs),
+    /// Horizontal disparity (x_left - x_right, pixels) at a gaze point of a rectified stereo
+    /// pair, from the log-polar images around it.
+    Vergence(VergenceArgs),
+}
+
+#[derive(Args, Debug)]
+struct RegisterArgs {
+    /// Reference image.
+    a: PathBuf,
+    /// Rotated and scaled image (same size).
+    b: PathBuf,
+    /// `direct`: rotation and scale about the image centres; `spectrum`: of the magnitude
+    /// spectra (Fourier-Mellin), so B may also be translated (the translation is printed).
+    #[arg(long, value_enum, default_value = "direct")]
+    mode: ModeArg,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum ModeArg {
+    Direct,
+    Spectrum,
+}
+
+#[derive(Args, Debug)]
+struct VergenceArgs {
+    /// Left image.
+    left: PathBuf,
+    /// Right image (rectified with the left).
+    right: PathBuf,
+    /// Gaze point `X,Y` in the left image, pixels.
+    #[arg(long, value_parser = parse_point)]
+    gaze: [f64; 2],
+    /// Largest disparity searched, pixels.
+    #[arg(long, default_value_t = 64)]
+    max_disparity: i64,
+    /// Outer radius of the compared field, pixels.
+    #[arg(long, default_value_t = 24.0)]
+    radius: f64,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+fn parse_point(s: &str) -> std::result::Result<[f64; 2], String> {
+    let v: Vec<&str> = s.split(',').collect();
+    if v.len() != 2 {
+        return Err(format!("expected X,Y, got '{s}'"));
+    }
+    let p = |t: &str| t.trim().parse::<f64>().map_err(|e| format!("'{t}': {e}"));
+    let (x, y) = (p(v[0])?, p(v[1])?);
+    if !(x.is_finite() && y.is_finite()) {
+        return Err(format!("'{s}' is not a finite point"));
+    }
+    Ok([x, y])
+}
+
+fn grey_f32(path: &Path) -> Result<Plane<f32>> {
+    Ok(ocellus_io::read_image(path)?.to_luma8().map(|v| v as f32))
+}
+
+/// Runs the subcommand.
+pub fn run(a: LogPolarArgs) -> Result<()> {
+    match a.sub {
+        Some(Sub::Register(r)) => return run_register(&r),
+        Some(Sub::Vergence(v)) => return run_vergence(&v),
+        None => {}
+    }
+    let Some(path) = &a.image else { bail!("give an image") };
+    let img = ocellus_io::read_image(path)?;
+    let (w, h) = img.size();
+    let mut cfg = LogPolarConfig { rings: a.rings, sectors: a.sectors, ..LogPolarConfig::for_image(w, h) };
+    if let Some(c) = a.fovea {
+        cfg.centre = c;
+    }
+    if let Some(r) = a.max_radius {
+        cfg.max_radius = r;
+    }
+    cfg.fovea_radius = a.fovea_radius.unwrap_or((cfg.max_radius / 60.0).max(2.0).min(cfg.max_radius / 2.0));
+    cfg.fovea_rings = cfg.fovea_radius.round().max(1.0) as usize;
+    cfg.fields = match a.fields {
+        FieldsArg::Pyramid => Fields::Pyramid,
+        FieldsArg::Area => Fields::Area,
+    };
+    let t = std::time::Instant::now();
+    let map = LogPolarMap::new(&cfg, w, h)?;
+    let build_ms = t.elapsed().as_secs_f64() * 1e3;
+    let rgb = img.to_u8();
+    let t = std::time::Instant::now();
+    let [r, g, b] = map.sample_rgb(&rgb)?;
+    let sample_us = t.elapsed().as_secs_f64() * 1e6;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    let to_rgb = |p: [&Plane<f32>; 3]| {
+        let (pw, ph) = p[0].size();
+        Plane::from_fn(pw, ph, |x, y| p.map(|c| c.get(x, y).round().clamp(0.0, 255.0) as u8))
+    };
+    let cortex = to_rgb([&r, &g, &b]);
+    ocellus_io::write_png(a.out.join("cortex.png"), &ocellus_image::convert::to_image_rgb8(&cortex))?;
+    let (ir, ig, ib) = (map.inverse(&r)?, map.inverse(&g)?, map.inverse(&b)?);
+    let inverse = to_rgb([&ir, &ig, &ib]);
+    ocellus_io::write_png(a.out.join("inverse.png"), &ocellus_image::convert::to_image_rgb8(&inverse))?;
+    let info = serde_json::json!({
+        "image": [w, h],
+        "config": cfg,
+        "ring_ratio": cfg.ring_ratio(),
+        "cortex_rows": map.rows(),
+        "cortex_columns": map.sectors(),
+        "fovea_rows": cfg.fovea_rings,
+        "compression_ratio": map.compression_ratio(),
+        "table_entries": map.table_entries(),
+        "table_build_ms": build_ms,
+        "rgb_sample_us_first_call": sample_us,
+    });
+    std::fs::write(a.out.join("logpolar.json"), serde_json::to_string_pretty(&info)?)?;
+    println!(
+        "{w}x{h} -> {} rows ({} fovea + {} log rings, ratio {:.5}) x {} sectors: compression {:.1}x; wrote cortex.png, inverse.png, logpolar.json in {}",
+        map.rows(),
+        cfg.fovea_rings,
+        cfg.rings,
+        cfg.ring_ratio(),
+        map.sectors(),
+        map.compression_ratio(),
+        a.out.display()
+    );
+    Ok(())
+}
+
+fn run_register(r: &RegisterArgs) -> Result<()> {
+    let (a, b) = (grey_f32(&r.a)?, grey_f32(&r.b)?);
+    let mode = match r.mode {
+        ModeArg::Direct => Mode::Direct,
+        ModeArg::Spectrum => Mode::Spectrum,
+    };
+    let est = register(&a, &b, &RegisterOptions { mode, ..Default::default() })?;
+    if r.json {
+        println!("{}", serde_json::to_string(&est)?);
+    } else {
+        println!("rotation {:.3} deg, scale {:.5}", est.angle_deg, est.scale);
+        if mode == Mode::Spectrum {
+            println!("translation {:.2}, {:.2} px", est.translation[0], est.translation[1]);
+        }
+        println!("peak {:.3}", est.peak);
+    }
+    Ok(())
+}
+
+fn run_vergence(v: &VergenceArgs) -> Result<()> {
+    let l = ocellus_io::read_image(&v.left)?.to_luma8();
+    let r = ocellus_io::read_image(&v.right)?.to_luma8();
+    let opts = VergenceOptions { max_disparity: v.max_disparity, max_radius: v.radius, ..Default::default() };
+    let est = vergence(&l, &r, v.gaze, &opts)?;
+    if v.json {
+        println!("{}", serde_json::to_string(&est)?);
+    } else {
+        println!("disparity {:.2} px (correlation {:.3})", est.disparity_px, est.score);
+    }
+    Ok(())
+}
