@@ -557,11 +557,30 @@ impl LogPolarMap {
                 continue;
             }
             let (i, dy) = (b as usize * C, row_step.get(l as usize).copied().unwrap_or(0));
+            let last = i + dy + 2 * C - 1;
+            let in_bounds = if l == 0 { last < src.len() } else { last < pyr.len() };
+            if !in_bounds {
+                o.fill(0.0);
+                continue;
+            }
             for ch in 0..C {
-                let (p00, p01, p10, p11) = if l == 0 {
-                    (src[i + ch].into(), src[i + C + ch].into(), src[i + dy + ch].into(), src[i + dy + C + ch].into())
-                } else {
-                    (pyr[i + ch], pyr[i + C + ch], pyr[i + dy + ch], pyr[i + dy + C + ch])
+                // SAFETY: the quad's largest index, `last`, was checked just above.
+                let (p00, p01, p10, p11) = unsafe {
+                    if l == 0 {
+                        (
+                            (*src.get_unchecked(i + ch)).into(),
+                            (*src.get_unchecked(i + C + ch)).into(),
+                            (*src.get_unchecked(i + dy + ch)).into(),
+                            (*src.get_unchecked(i + dy + C + ch)).into(),
+                        )
+                    } else {
+                        (
+                            *pyr.get_unchecked(i + ch),
+                            *pyr.get_unchecked(i + C + ch),
+                            *pyr.get_unchecked(i + dy + ch),
+                            *pyr.get_unchecked(i + dy + C + ch),
+                        )
+                    }
                 };
                 let top = p00 + fx * (p01 - p00);
                 let bot = p10 + fx * (p11 - p10);
