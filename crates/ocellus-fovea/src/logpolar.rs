@@ -125,6 +125,7 @@ impl LogPolarConfig {
 pub struct Scratch {
     pyramid: Vec<f32>,
     row: Vec<f32>,
+    pyramid16: Vec<u16>,
 }
 
 /// A log-polar map for one image size and one gaze point: the sparse weight table and what
@@ -145,7 +146,14 @@ pub struct LogPolarMap {
     /// [`Fields::Pyramid`] cells: index of the top-left texel of the bilinear quad and the
     /// fractions (fx, fy) towards the next column and row.
     quad_base: Vec<u32>,
-    quad_frac: Vec<[f32; 2]>,
+    quad_fx: Vec<f32>,
+    quad_fy: Vec<f32>,
+    /// [`Fields::Pyramid`] cells whose centroid is off the image (their quad reads texel 0
+    /// and their output is set to 0).
+    invalid: Vec<u32>,
+    /// [`Fields::Pyramid`] cells of each level, when the levels do not decrease from cell to
+    /// cell (always, for the ring-major order): the grey fast path runs level by level.
+    level_ranges: Option<Vec<std::ops::Range<usize>>>,
     coverage: Vec<f32>,
     /// Start of each level in the pyramid buffer (in texels), levels 1..=levels.
     level_base: Vec<usize>,
@@ -194,7 +202,10 @@ impl LogPolarMap {
             offset: Vec::new(),
             weight: Vec::new(),
             quad_base: Vec::new(),
-            quad_frac: Vec::new(),
+            quad_fx: Vec::new(),
+            quad_fy: Vec::new(),
+            invalid: Vec::new(),
+            level_ranges: None,
             coverage: Vec::with_capacity(cells),
             level_base,
             levels: 0,
@@ -276,6 +287,18 @@ impl LogPolarMap {
             }
         }
         map.pyramid_rect = map.rect_read();
+        if cfg.fields == Fields::Pyramid && map.level.windows(2).all(|p| p[0] <= p[1]) {
+            let mut ranges = vec![0..0; map.levels + 1];
+            for (l, r) in ranges.iter_mut().enumerate() {
+                let a = map.level.partition_point(|&v| (v as usize) < l);
+                let b = map.level.partition_point(|&v| (v as usize) <= l);
+                *r = a..b;
+            }
+            // Cells above `levels` exist only when they read nothing (all invalid).
+            if ranges.last().map_or(0, |r| r.end) == map.level.len() {
+                map.level_ranges = Some(ranges);
+            }
+        }
         Ok(map)
     }
 
@@ -301,9 +324,9 @@ impl LogPolarMap {
                 y1 = y1.max((y + 1) << l);
             }
         }
-        for (&b, &l) in self.quad_base.iter().zip(&self.level) {
+        for (c, (&b, &l)) in self.quad_base.iter().zip(&self.level).enumerate() {
             let l = l as usize;
-            if l == 0 || b == u32::MAX {
+            if l == 0 || self.invalid.binary_search(&(c as u32)).is_ok() {
                 continue;
             }
             let (lw, _) = level_size(self.width, self.height, l);
@@ -341,7 +364,10 @@ impl LogPolarMap {
         for o in out.offset.iter_mut() {
             *o = (*o as i64 + delta) as u32;
         }
-        for o in out.quad_base.iter_mut().filter(|o| **o != u32::MAX) {
+        if !out.invalid.is_empty() {
+            return None;
+        }
+        for o in out.quad_base.iter_mut() {
             *o = (*o as i64 + delta) as u32;
         }
         Some(out)
@@ -370,11 +396,14 @@ impl LogPolarMap {
             let (xc, yc) = (x.clamp(0.0, (lw - 1) as f64), y.clamp(0.0, (lh - 1) as f64));
             let (x0, y0) = ((xc.floor() as usize).min(lw - 2), (yc.floor() as usize).min(lh - 2));
             self.quad_base.push((base + y0 * lw + x0) as u32);
-            self.quad_frac.push([(xc - x0 as f64) as f32, (yc - y0 as f64) as f32]);
+            self.quad_fx.push((xc - x0 as f64) as f32);
+            self.quad_fy.push((yc - y0 as f64) as f32);
             self.levels = self.levels.max(l);
         } else {
-            self.quad_base.push(u32::MAX);
-            self.quad_frac.push([0.0, 0.0]);
+            self.invalid.push(self.quad_base.len() as u32);
+            self.quad_base.push(base as u32);
+            self.quad_fx.push(0.0);
+            self.quad_fy.push(0.0);
         }
         self.start.push(self.offset.len() as u32);
         self.level.push(l as u8);
@@ -454,7 +483,10 @@ impl LogPolarMap {
         self.check_size(img.width(), img.height())?;
         out.resize(self.cfg.sectors, self.rows);
         let src = contiguous(img);
-        self.apply::<u8, 1>(&src, scratch, out_slice(out));
+        let o = out_slice(out);
+        if self.cfg.fields != Fields::Pyramid || !self.apply_grey_pyramid(&src, scratch, o) {
+            self.apply::<u8, 1>(&src, scratch, o);
+        }
         Ok(())
     }
 
@@ -549,13 +581,9 @@ impl LogPolarMap {
     /// The [`Fields::Pyramid`] table: one bilinear quad per cell.
     fn apply_quads<T: Texel, const C: usize>(&self, src: &[T], pyr: &[f32], out: &mut [f32]) {
         let row_step: Vec<usize> = (0..=self.levels).map(|l| level_size(self.width, self.height, l).0 * C).collect();
-        for (((o, &b), &[fx, fy]), &l) in
-            out.chunks_exact_mut(C).zip(&self.quad_base).zip(&self.quad_frac).zip(&self.level)
+        for ((((o, &b), &fx), &fy), &l) in
+            out.chunks_exact_mut(C).zip(&self.quad_base).zip(&self.quad_fx).zip(&self.quad_fy).zip(&self.level)
         {
-            if b == u32::MAX {
-                o.fill(0.0);
-                continue;
-            }
             let (i, dy) = (b as usize * C, row_step.get(l as usize).copied().unwrap_or(0));
             let last = i + dy + 2 * C - 1;
             let in_bounds = if l == 0 { last < src.len() } else { last < pyr.len() };
@@ -587,6 +615,65 @@ impl LogPolarMap {
                 o[ch] = top + fy * (bot - top);
             }
         }
+        self.zero_invalid::<C>(out);
+    }
+
+    fn zero_invalid<const C: usize>(&self, out: &mut [f32]) {
+        for &c in &self.invalid {
+            if let Some(o) = out.get_mut(c as usize * C..c as usize * C + C) {
+                o.fill(0.0);
+            }
+        }
+    }
+
+    /// Grey images with [`Fields::Pyramid`]: the pyramid as exact u16 box sums (a level-l
+    /// texel holds the sum of 4^l pixels; up to level 4 that fits), then each level's cells
+    /// as one run of bilinear quads, 8 cells per step with AVX2 gathers where the CPU has
+    /// them. Returns false (nothing done) when the map does not allow it.
+    fn apply_grey_pyramid(&self, src: &[u8], scratch: &mut Scratch, out: &mut [f32]) -> bool {
+        let Some(ranges) = &self.level_ranges else { return false };
+        let (w, h) = (self.width, self.height);
+        if src.len() < w * h || out.len() < self.quad_base.len() {
+            return false;
+        }
+        let top = self.levels;
+        if top > 0 {
+            let total = self.level_base[top] + level_size(w, h, top).0 * level_size(w, h, top).1;
+            scratch.pyramid16.resize(total, 0);
+            let [rx0, ry0, rx1, ry1] = self.pyramid_rect;
+            for l in 1..=top {
+                let (pw, _) = level_size(w, h, l - 1);
+                let (lw, lh) = level_size(w, h, l);
+                let (tx0, ty0) = (rx0 >> l, ry0 >> l);
+                let (tx1, ty1) = ((rx1 >> l).min(lw), (ry1 >> l).min(lh));
+                if tx1 <= tx0 || ty1 <= ty0 {
+                    continue;
+                }
+                let (lo, hi) = scratch.pyramid16.split_at_mut(self.level_base[l]);
+                let dst = &mut hi[..lw * lh];
+                if l == 1 {
+                    sum4_u8(src, pw, dst, lw, [tx0, ty0, tx1, ty1]);
+                } else {
+                    sum4(&lo[self.level_base[l - 1]..], pw, dst, lw, [tx0, ty0, tx1, ty1]);
+                }
+            }
+        }
+        for (l, r) in ranges.iter().enumerate() {
+            if r.is_empty() {
+                continue;
+            }
+            let (lw, _) = level_size(w, h, l);
+            let scale = 1.0 / (1u32 << (2 * l)) as f32;
+            let (b, fx, fy) = (&self.quad_base[r.clone()], &self.quad_fx[r.clone()], &self.quad_fy[r.clone()]);
+            let o = &mut out[r.clone()];
+            if l == 0 {
+                quads(src, lw, b, fx, fy, 1.0, o);
+            } else {
+                quads(&scratch.pyramid16, lw, b, fx, fy, scale, o);
+            }
+        }
+        self.zero_invalid::<1>(out);
+        true
     }
 
     /// Back to a `width` x `height` Cartesian image for display: each pixel reads the
@@ -746,6 +833,172 @@ fn halve<T: Texel, const C: usize>(
             for ch in 0..C {
                 o[ch] = 0.25 * (pair[ch] + pair[C + ch]);
             }
+        }
+    }
+}
+
+/// Sources of the grey fast path: u8 pixels (level 0) or u16 box sums.
+trait Quad: Copy + Into<f32> {
+    /// Whether 8 quads can be read with AVX2 gathers from a buffer of `len` elements with rows
+    /// of `lw`: a gather reads 4 bytes at each quad's two rows.
+    fn gather_safe(bases: &[u32], lw: usize, len: usize) -> bool;
+}
+
+impl Quad for u8 {
+    fn gather_safe(bases: &[u32], lw: usize, len: usize) -> bool {
+        bases.iter().all(|&b| b as usize + lw + 4 <= len)
+    }
+}
+
+impl Quad for u16 {
+    fn gather_safe(bases: &[u32], lw: usize, len: usize) -> bool {
+        bases.iter().all(|&b| b as usize + lw + 2 <= len)
+    }
+}
+
+/// Bilinear quads `src[b], src[b + 1], src[b + lw], src[b + lw + 1]` with fractions
+/// (fx, fy), times `scale`, into `out`.
+fn quads<T: Quad>(src: &[T], lw: usize, bases: &[u32], fx: &[f32], fy: &[f32], scale: f32, out: &mut [f32]) {
+    let n = bases.len().min(fx.len()).min(fy.len()).min(out.len());
+    let mut done = 0;
+    #[cfg(target_arch = "x86_64")]
+    if n >= 8
+        && src.len() < i32::MAX as usize
+        && is_x86_feature_detected!("avx2")
+        && T::gather_safe(&bases[..n], lw, src.len())
+    {
+        // SAFETY: AVX2 detected; every gather reads inside `src` (checked just above).
+        done = unsafe { quads_avx2(src, lw, &bases[..n], &fx[..n], &fy[..n], scale, &mut out[..n]) };
+    }
+    for k in done..n {
+        let b = bases[k] as usize;
+        let (Some(&p00), Some(&p01), Some(&p10), Some(&p11)) =
+            (src.get(b), src.get(b + 1), src.get(b + lw), src.get(b + lw + 1))
+        else {
+            out[k] = 0.0;
+            continue;
+        };
+        let (p00, p01, p10, p11): (f32, f32, f32, f32) = (p00.into(), p01.into(), p10.into(), p11.into());
+        let top = p00 + fx[k] * (p01 - p00);
+        let bot = p10 + fx[k] * (p11 - p10);
+        out[k] = scale * (top + fy[k] * (bot - top));
+    }
+}
+
+/// [`quads`] 8 at a time; returns how many were done (a multiple of 8).
+///
+/// # Safety
+/// AVX2 must be available, `src.len() < 2^31`, and for every base b, the 4 bytes from
+/// element b and from element b + lw must lie inside `src`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn quads_avx2<T: Quad>(
+    src: &[T],
+    lw: usize,
+    bases: &[u32],
+    fx: &[f32],
+    fy: &[f32],
+    scale: f32,
+    out: &mut [f32],
+) -> usize {
+    use std::arch::x86_64::*;
+    let n = bases.len() / 8 * 8;
+    let wide = std::mem::size_of::<T>() == 2;
+    // SAFETY (whole body): the caller guarantees the feature and the gathers' bounds; the
+    // other loads and stores are within the slices (k + 8 <= n).
+    unsafe {
+        let p = src.as_ptr() as *const i32;
+        let row = _mm256_set1_epi32(lw as i32);
+        let (mask, shift) = if wide { (_mm256_set1_epi32(0xffff), 16) } else { (_mm256_set1_epi32(0xff), 8) };
+        let sc = _mm256_set1_ps(scale);
+        let mut k = 0;
+        while k < n {
+            let idx = _mm256_loadu_si256(bases.as_ptr().add(k) as *const __m256i);
+            let (t, b) = if wide {
+                (_mm256_i32gather_epi32::<2>(p, idx), _mm256_i32gather_epi32::<2>(p, _mm256_add_epi32(idx, row)))
+            } else {
+                (_mm256_i32gather_epi32::<1>(p, idx), _mm256_i32gather_epi32::<1>(p, _mm256_add_epi32(idx, row)))
+            };
+            let split = |v: __m256i| {
+                let lo = _mm256_cvtepi32_ps(_mm256_and_si256(v, mask));
+                let hi = if wide {
+                    _mm256_cvtepi32_ps(_mm256_srli_epi32::<16>(v))
+                } else {
+                    _mm256_cvtepi32_ps(_mm256_and_si256(_mm256_srli_epi32::<8>(v), mask))
+                };
+                (lo, hi)
+            };
+            let _ = shift;
+            let ((p00, p01), (p10, p11)) = (split(t), split(b));
+            let x = _mm256_loadu_ps(fx.as_ptr().add(k));
+            let y = _mm256_loadu_ps(fy.as_ptr().add(k));
+            let top = _mm256_add_ps(p00, _mm256_mul_ps(x, _mm256_sub_ps(p01, p00)));
+            let bot = _mm256_add_ps(p10, _mm256_mul_ps(x, _mm256_sub_ps(p11, p10)));
+            let v = _mm256_add_ps(top, _mm256_mul_ps(y, _mm256_sub_ps(bot, top)));
+            _mm256_storeu_ps(out.as_mut_ptr().add(k), _mm256_mul_ps(v, sc));
+            k += 8;
+        }
+        n
+    }
+}
+
+/// [`sum4`] from u8 pixels, 16 texels per step with AVX2 where the CPU has it.
+fn sum4_u8(src: &[u8], sw: usize, dst: &mut [u16], lw: usize, rect: [usize; 4]) {
+    #[cfg(target_arch = "x86_64")]
+    if is_x86_feature_detected!("avx2") {
+        let [x0, y0, x1, y1] = rect;
+        let n = x1 - x0;
+        for y in y0..y1 {
+            let a = &src[2 * y * sw + 2 * x0..][..2 * n];
+            let b = &src[(2 * y + 1) * sw + 2 * x0..][..2 * n];
+            let d = &mut dst[y * lw + x0..y * lw + x1];
+            // SAFETY: AVX2 detected; the kernel reads and writes inside the three slices.
+            let done = unsafe { sum4_row_avx2(a, b, d) };
+            for i in done..n {
+                d[i] = a[2 * i] as u16 + a[2 * i + 1] as u16 + b[2 * i] as u16 + b[2 * i + 1] as u16;
+            }
+        }
+        return;
+    }
+    sum4(src, sw, dst, lw, rect)
+}
+
+/// Sums of 2x2 bytes of rows `a` and `b` into `d`, 16 at a time; returns how many were done.
+///
+/// # Safety
+/// AVX2 must be available.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn sum4_row_avx2(a: &[u8], b: &[u8], d: &mut [u16]) -> usize {
+    use std::arch::x86_64::*;
+    let n = (d.len().min(a.len() / 2).min(b.len() / 2)) / 16 * 16;
+    // SAFETY (whole body): i + 16 <= n outputs, so 2 i + 32 <= 2 n input bytes of each row.
+    unsafe {
+        let ones = _mm256_set1_epi8(1);
+        let mut i = 0;
+        while i < n {
+            let va = _mm256_loadu_si256(a.as_ptr().add(2 * i) as *const __m256i);
+            let vb = _mm256_loadu_si256(b.as_ptr().add(2 * i) as *const __m256i);
+            // Pairs of unsigned bytes times 1, summed: 16 words per row, exact.
+            let s = _mm256_add_epi16(_mm256_maddubs_epi16(va, ones), _mm256_maddubs_epi16(vb, ones));
+            _mm256_storeu_si256(d.as_mut_ptr().add(i) as *mut __m256i, s);
+            i += 16;
+        }
+        n
+    }
+}
+
+/// One level of the u16 box-sum pyramid: texels `rect` of `dst` (rows of `lw`) are the sums
+/// of 2x2 elements of `src` (rows of `sw`).
+fn sum4<T: Copy + Into<u16>>(src: &[T], sw: usize, dst: &mut [u16], lw: usize, rect: [usize; 4]) {
+    let [x0, y0, x1, y1] = rect;
+    let n = x1 - x0;
+    for y in y0..y1 {
+        let a = &src[2 * y * sw + 2 * x0..][..2 * n];
+        let b = &src[(2 * y + 1) * sw + 2 * x0..][..2 * n];
+        let d = &mut dst[y * lw + x0..y * lw + x1];
+        for ((o, p), q) in d.iter_mut().zip(a.chunks_exact(2)).zip(b.chunks_exact(2)) {
+            *o = p[0].into() + p[1].into() + q[0].into() + q[1].into();
         }
     }
 }
