@@ -1041,6 +1041,25 @@ mod tests {
     }
 
     #[test]
+    fn the_grey_fast_path_equals_the_general_one() {
+        // Gaze points in the middle, near a corner (cells off the image, quads at the last
+        // row and column) and outside the image.
+        let (w, h) = (203, 157);
+        let mut rng = ocellus_image::rng::SplitMix64::new(5);
+        let img = Plane::from_fn(w, h, |_, _| rng.below(256) as u8);
+        let f = img.map(|v| v as f32);
+        for centre in [[101.0, 78.0], [199.5, 154.2], [3.0, 150.0], [-30.0, 40.0]] {
+            let cfg = LogPolarConfig { centre, rings: 40, sectors: 37, ..LogPolarConfig::for_image(w, h) };
+            let map = LogPolarMap::new(&cfg, w, h).unwrap();
+            assert!(map.level_ranges.is_some());
+            let (fast, general) = (map.sample_grey(&img).unwrap(), map.sample_f32(&f).unwrap());
+            for (a, b) in fast.rows().flatten().zip(general.rows().flatten()) {
+                assert!((a - b).abs() < 1e-3, "{centre:?}: {a} {b}");
+            }
+        }
+    }
+
+    #[test]
     fn a_quarter_turn_is_a_shift_by_a_quarter_of_the_sectors() {
         // 32 = 2^5: the pyramid's texel grids are symmetric about the centre (15.5, 15.5) at
         // every level, so pyramid fields turn with the image too (for other sizes they do up
