@@ -156,6 +156,8 @@ pub struct LogPolarMap {
     /// [`Fields::Pyramid`] cells of each level, when the levels do not decrease from cell to
     /// cell (always, for the ring-major order): the grey fast path runs level by level.
     level_ranges: Option<Vec<std::ops::Range<usize>>>,
+    /// The largest quad base of each level's range (whether its gathers stay in bounds).
+    level_max_base: Vec<usize>,
     coverage: Vec<f32>,
     /// Start of each level in the pyramid buffer (in texels), levels 1..=levels.
     level_base: Vec<usize>,
@@ -213,6 +215,7 @@ impl LogPolarMap {
             quad_fy: Vec::new(),
             invalid: Vec::new(),
             level_ranges: None,
+            level_max_base: Vec::new(),
             coverage: Vec::with_capacity(cells),
             level_base,
             levels: 0,
@@ -322,6 +325,8 @@ impl LogPolarMap {
             }
             // Cells above `levels` exist only when they read nothing (all invalid).
             if ranges.last().map_or(0, |r| r.end) == map.level.len() {
+                map.level_max_base =
+                    ranges.iter().map(|r| map.quad_base[r.clone()].iter().map(|&b| b as usize).max().unwrap_or(0)).collect();
                 map.level_ranges = Some(ranges);
             }
         }
@@ -728,6 +733,7 @@ impl LogPolarMap {
             let (lw, _) = level_size(self.width, self.height, l);
             let scale = 1.0 / (1u32 << (2 * l)) as f32;
             let (b, fx, fy) = (&self.quad_base[r.clone()], &self.quad_fx[r.clone()], &self.quad_fy[r.clone()]);
+            let b = (b, self.level_max_base.get(l).copied().unwrap_or(usize::MAX));
             let o = &mut out[r.clone()];
             if l == 0 {
                 quads(level0, lw, b, fx, fy, 1.0, o);
@@ -957,31 +963,36 @@ fn halve<T: Texel, const C: usize>(
 trait Quad: Copy + Into<f32> {
     /// Whether 8 quads can be read with AVX2 gathers from a buffer of `len` elements with rows
     /// of `lw`: a gather reads 4 bytes at each quad's two rows.
-    fn gather_safe(bases: &[u32], lw: usize, len: usize) -> bool;
+    fn gather_safe(max_base: usize, lw: usize, len: usize) -> bool;
 }
 
 impl Quad for u8 {
-    fn gather_safe(bases: &[u32], lw: usize, len: usize) -> bool {
-        bases.iter().all(|&b| b as usize + lw + 4 <= len)
+    fn gather_safe(max_base: usize, lw: usize, len: usize) -> bool {
+        max_base + lw + 4 <= len
     }
 }
 
 impl Quad for u16 {
-    fn gather_safe(bases: &[u32], lw: usize, len: usize) -> bool {
-        bases.iter().all(|&b| b as usize + lw + 2 <= len)
+    fn gather_safe(max_base: usize, lw: usize, len: usize) -> bool {
+        max_base + lw + 2 <= len
     }
 }
 
 /// Bilinear quads `src[b], src[b + 1], src[b + lw], src[b + lw + 1]` with fractions
-/// (fx, fy), times `scale`, into `out`.
-fn quads<T: Quad>(src: &[T], lw: usize, bases: &[u32], fx: &[f32], fy: &[f32], scale: f32, out: &mut [f32]) {
+/// (fx, fy), times `scale`, into `out`; `max_base` is the largest of `bases`.
+fn quads<T: Quad>(
+    src: &[T],
+    lw: usize,
+    (bases, max_base): (&[u32], usize),
+    fx: &[f32],
+    fy: &[f32],
+    scale: f32,
+    out: &mut [f32],
+) {
     let n = bases.len().min(fx.len()).min(fy.len()).min(out.len());
     let mut done = 0;
     #[cfg(target_arch = "x86_64")]
-    if n >= 8
-        && src.len() < i32::MAX as usize
-        && is_x86_feature_detected!("avx2")
-        && T::gather_safe(&bases[..n], lw, src.len())
+    if n >= 8 && src.len() < i32::MAX as usize && is_x86_feature_detected!("avx2") && T::gather_safe(max_base, lw, src.len())
     {
         // SAFETY: AVX2 detected; every gather reads inside `src` (checked just above).
         done = unsafe { quads_avx2(src, lw, &bases[..n], &fx[..n], &fy[..n], scale, &mut out[..n]) };
