@@ -126,6 +126,7 @@ pub struct Scratch {
     pyramid: Vec<f32>,
     row: Vec<f32>,
     pyramid16: Vec<u16>,
+    pyramid_rgb: Vec<u16>,
     planes: Vec<u8>,
     channels: Vec<f32>,
 }
@@ -762,7 +763,9 @@ impl LogPolarMap {
         let mut planes = std::mem::take(&mut scratch.planes);
         planes.resize(3 * pitch, 0);
         let plen = self.pyramid_len();
-        let mut pyr = std::mem::take(&mut scratch.pyramid16);
+        // Its own buffer: sharing the grey one would zero-fill two thirds of it on every
+        // switch between grey and RGB frames.
+        let mut pyr = std::mem::take(&mut scratch.pyramid_rgb);
         pyr.resize(3 * plen, 0);
         {
             let [x0, y0, x1, y1] = self.level0_rect;
@@ -796,7 +799,7 @@ impl LogPolarMap {
             self.grey_quads(&planes[c * pitch..c * pitch + n], p, chan);
         }
         scratch.planes = planes;
-        scratch.pyramid16 = pyr;
+        scratch.pyramid_rgb = pyr;
         true
     }
 
