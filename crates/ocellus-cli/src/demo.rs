@@ -1,10 +1,11 @@
 //! `ocellus demo`: the main capabilities end to end on the built-in images.
 
 use crate::attend::{self, AttendArgs, StreamOptions};
-use crate::{assets, generate, inputs, saliency_cmd};
+use crate::{assets, generate, inputs, logpolar_cmd, saliency_cmd};
 use anyhow::{Context, Result};
 use clap::Args;
 use ocellus_attention::SaliencyConfig;
+use ocellus_fovea::logpolar::{LogPolarConfig, LogPolarMap};
 use ocellus_synth::attention_scenes::{Scenario, SceneConfig};
 use std::path::PathBuf;
 
@@ -16,14 +17,15 @@ pub struct DemoArgs {
     pub out: PathBuf,
 }
 
-/// Runs the demo: saliency maps, conspicuity maps and overlays with both presets, then
-/// attention over a generated sequence.
+/// Runs the demo: saliency maps, conspicuity maps and overlays with both presets, log-polar
+/// images fixating each image's most salient point, then attention over a generated sequence.
 pub fn run(a: DemoArgs) -> Result<()> {
     let dir = a.out;
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let src = dir.join("inputs");
     std::fs::create_dir_all(&src)?;
     println!("ocellus demo: bottom-up saliency (Itti-Koch-Niebur) on {} built-in images", assets::IMAGES.len());
+    let mut peaks = Vec::new();
     for preset in SaliencyConfig::PRESETS {
         let cfg = SaliencyConfig::preset(preset)?;
         let out = dir.join(preset);
@@ -34,6 +36,9 @@ pub fn run(a: DemoArgs) -> Result<()> {
             std::fs::write(&path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
             let r = saliency_cmd::process_one(&path, &cfg, &mut engine, &out, true)?;
             let t = engine.as_ref().map(|e| e.timings().total().as_secs_f64() * 1e3).unwrap_or(0.0);
+            if *preset == SaliencyConfig::PRESETS[0] {
+                peaks.push((path.clone(), r.peak_px));
+            }
             println!(
                 "  {preset:>8} {:<10} map {}x{}, most salient at ({:.0}, {:.0}) px, {:.2} ms, {} files",
                 inputs::stem(&path),
@@ -47,6 +52,30 @@ pub fn run(a: DemoArgs) -> Result<()> {
         }
     }
     println!("wrote maps, conspicuity maps and overlays to {}", dir.display());
+
+    // Foveal vision: each image seen through the log-polar retina fixating its most salient
+    // point (where to look, then look there).
+    println!("ocellus demo: log-polar images fixating the most salient point of each image");
+    let fov = dir.join("logpolar");
+    std::fs::create_dir_all(&fov)?;
+    for (path, (px, py)) in &peaks {
+        let img = ocellus_io::read_image(path)?.to_u8();
+        let (w, h) = img.size();
+        // The saliency peak is in edge coordinates (pixel centres at +0.5); the map puts
+        // pixel centres at integers.
+        let cfg = LogPolarConfig { centre: [*px as f64 - 0.5, *py as f64 - 0.5], ..LogPolarConfig::for_image(w, h) };
+        let map = LogPolarMap::new(&cfg, w, h)?;
+        let stem = inputs::stem(path);
+        let (c, i) = (fov.join(format!("{stem}.cortex.png")), fov.join(format!("{stem}.inverse.png")));
+        logpolar_cmd::write_foveated(&map, &img, &c, &i)?;
+        println!(
+            "  {stem:<10} gaze ({px:.0}, {py:.0}) px: {} rows x {} sectors, compression {:.1}x",
+            map.rows(),
+            map.sectors(),
+            map.compression_ratio()
+        );
+    }
+    println!("wrote cortical images and their inverses to {}", fov.display());
 
     // Attention over time: a generated sequence in which an object appears at frame 15.
     println!("ocellus demo: surprise, context chaos and attention on a generated 30-frame sequence");

@@ -145,20 +145,10 @@ pub fn run(a: LogPolarArgs) -> Result<()> {
     let t = std::time::Instant::now();
     let map = LogPolarMap::new(&cfg, w, h)?;
     let build_ms = t.elapsed().as_secs_f64() * 1e3;
-    let rgb = img.to_u8();
-    let t = std::time::Instant::now();
-    let [r, g, b] = map.sample_rgb(&rgb)?;
-    let sample_us = t.elapsed().as_secs_f64() * 1e6;
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
-    let to_rgb = |p: [&Plane<f32>; 3]| {
-        let (pw, ph) = p[0].size();
-        Plane::from_fn(pw, ph, |x, y| p.map(|c| c.get(x, y).round().clamp(0.0, 255.0) as u8))
-    };
-    let cortex = to_rgb([&r, &g, &b]);
-    ocellus_io::write_png(a.out.join("cortex.png"), &ocellus_image::convert::to_image_rgb8(&cortex))?;
-    let (ir, ig, ib) = (map.inverse(&r)?, map.inverse(&g)?, map.inverse(&b)?);
-    let inverse = to_rgb([&ir, &ig, &ib]);
-    ocellus_io::write_png(a.out.join("inverse.png"), &ocellus_image::convert::to_image_rgb8(&inverse))?;
+    let t = std::time::Instant::now();
+    write_foveated(&map, &img.to_u8(), &a.out.join("cortex.png"), &a.out.join("inverse.png"))?;
+    let sample_us = t.elapsed().as_secs_f64() * 1e6;
     let info = serde_json::json!({
         "image": [w, h],
         "config": cfg,
@@ -169,7 +159,7 @@ pub fn run(a: LogPolarArgs) -> Result<()> {
         "compression_ratio": map.compression_ratio(),
         "table_entries": map.table_entries(),
         "table_build_ms": build_ms,
-        "rgb_sample_us_first_call": sample_us,
+        "rgb_sample_and_write_us": sample_us,
     });
     std::fs::write(a.out.join("logpolar.json"), serde_json::to_string_pretty(&info)?)?;
     println!(
@@ -182,6 +172,19 @@ pub fn run(a: LogPolarArgs) -> Result<()> {
         map.compression_ratio(),
         a.out.display()
     );
+    Ok(())
+}
+
+/// Writes the cortical image of `rgb` under `map` and its inverse as PNG files.
+pub fn write_foveated(map: &LogPolarMap, rgb: &Plane<[u8; 3]>, cortex_png: &Path, inverse_png: &Path) -> Result<()> {
+    let [r, g, b] = map.sample_rgb(rgb)?;
+    let to_rgb = |p: [&Plane<f32>; 3]| {
+        let (pw, ph) = p[0].size();
+        Plane::from_fn(pw, ph, |x, y| p.map(|c| c.get(x, y).round().clamp(0.0, 255.0) as u8))
+    };
+    ocellus_io::write_png(cortex_png, &ocellus_image::convert::to_image_rgb8(&to_rgb([&r, &g, &b])))?;
+    let (ir, ig, ib) = (map.inverse(&r)?, map.inverse(&g)?, map.inverse(&b)?);
+    ocellus_io::write_png(inverse_png, &ocellus_image::convert::to_image_rgb8(&to_rgb([&ir, &ig, &ib])))?;
     Ok(())
 }
 

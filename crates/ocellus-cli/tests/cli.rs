@@ -106,6 +106,7 @@ fn demo_runs_on_built_in_images() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.join("ace2009/astronaut.overlay.png").is_file());
     assert!(out.join("stb/rocket.saliency.npy").is_file());
+    assert!(out.join("logpolar/chelsea.cortex.png").is_file() && out.join("logpolar/chelsea.inverse.png").is_file());
 }
 
 #[test]
