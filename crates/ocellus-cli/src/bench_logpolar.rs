@@ -3,6 +3,8 @@
 use crate::bench::median;
 use anyhow::{Context, Result};
 use ocellus_fovea::logpolar::{Fields, LogPolarConfig, LogPolarMap, Scratch};
+use ocellus_fovea::register::{register, Mode, RegisterOptions};
+use ocellus_fovea::vergence::{vergence, VergenceOptions};
 use ocellus_image::Plane;
 use serde_json::json;
 use std::time::Instant;
@@ -53,6 +55,31 @@ pub fn run(json_out: bool) -> Result<()> {
             figures.insert("compression_ratio".into(), json!(map.compression_ratio()));
         }
     }
+    // Registration of a 512x512 photo with a turned and scaled copy, and vergence over 65
+    // disparities on a pair made by shifting it 20 px.
+    let (name, bytes) =
+        crate::assets::IMAGES.iter().find(|(n, _)| *n == "astronaut.png").context("built-in astronaut.png missing")?;
+    let photo = ocellus_io::decode_image(bytes, std::path::Path::new(name))?.to_luma8();
+    let a = photo.map(|v| v as f32);
+    let b = ocellus_fovea::register::warp_similarity(&a, 0.5, 1.3);
+    for (key, mode) in [("ms_register_direct_512", Mode::Direct), ("ms_register_spectrum_512", Mode::Spectrum)] {
+        let mut t = Vec::new();
+        for _ in 0..5 {
+            let s = Instant::now();
+            register(&a, &b, &RegisterOptions { mode, ..Default::default() })?;
+            t.push(s.elapsed().as_secs_f64() * 1e3);
+        }
+        figures.insert(key.into(), json!(median(&mut t)));
+    }
+    let (pw, ph) = photo.size();
+    let right = Plane::from_fn(pw, ph, |x, y| photo.get((x + 20).min(pw - 1), y));
+    let mut t = Vec::new();
+    for _ in 0..20 {
+        let s = Instant::now();
+        vergence(&photo, &right, [300.0, 250.0], &VergenceOptions::default())?;
+        t.push(s.elapsed().as_secs_f64() * 1e3);
+    }
+    figures.insert("ms_vergence_65_disparities".into(), json!(median(&mut t)));
     let v = serde_json::Value::Object(figures);
     if json_out {
         println!("{v}");
