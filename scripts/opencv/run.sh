@@ -3,9 +3,5 @@
 # environment with opencv-python-headless in target/opencv-venv (network needed once).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-cargo build --release -q
-if [ ! -x target/opencv-venv/bin/python ]; then
-  python3 -m venv target/opencv-venv
-  target/opencv-venv/bin/pip install -q opencv-python-headless numpy
-fi
-target/opencv-venv/bin/python scripts/opencv/compare_calibration.py target/release/ocellus "${1:-20}"
+source scripts/opencv/venv.sh
+"$PY" scripts/opencv/compare_calibration.py target/release/ocellus "${1:-20}"

@@ -725,10 +725,10 @@ impl LogPolarMap {
             let dst = &mut hi[..lw * lh];
             if l == 1 {
                 if let Some(src) = level0 {
-                    sum4_u8(src, pw, dst, lw, rect);
+                    sum4(src, pw, dst, lw, rect);
                 }
             } else {
-                sum4_u16(&lo[self.level_base[l - 1]..], pw, dst, lw, rect);
+                sum4(&lo[self.level_base[l - 1]..], pw, dst, lw, rect);
             }
         }
     }
@@ -1097,27 +1097,6 @@ unsafe fn quads_avx2<T: Quad, const K: usize>(
     }
 }
 
-/// [`sum4`] from u8 pixels, 16 texels per step with AVX2 where the CPU has it.
-fn sum4_u8(src: &[u8], sw: usize, dst: &mut [u16], lw: usize, rect: [usize; 4]) {
-    #[cfg(target_arch = "x86_64")]
-    if is_x86_feature_detected!("avx2") {
-        let [x0, y0, x1, y1] = rect;
-        let n = x1 - x0;
-        for y in y0..y1 {
-            let a = &src[2 * y * sw + 2 * x0..][..2 * n];
-            let b = &src[(2 * y + 1) * sw + 2 * x0..][..2 * n];
-            let d = &mut dst[y * lw + x0..y * lw + x1];
-            // SAFETY: AVX2 detected; the kernel reads and writes inside the three slices.
-            let done = unsafe { sum4_row_avx2(a, b, d) };
-            for i in done..n {
-                d[i] = a[2 * i] as u16 + a[2 * i + 1] as u16 + b[2 * i] as u16 + b[2 * i + 1] as u16;
-            }
-        }
-        return;
-    }
-    sum4(src, sw, dst, lw, rect)
-}
-
 /// Sums of 2x2 bytes of rows `a` and `b` into `d`, 16 at a time; returns how many were done.
 ///
 /// # Safety
@@ -1320,28 +1299,6 @@ fn deinterleave(rgb: &[u8], r: &mut [u8], g: &mut [u8], b: &mut [u8]) {
     }
 }
 
-/// [`sum4`] from u16 sums of 4^(l-1) pixels (l <= 4, so every sum stays below 2^15 until
-/// the last pair), 16 texels per step with AVX2 where the CPU has it.
-fn sum4_u16(src: &[u16], sw: usize, dst: &mut [u16], lw: usize, rect: [usize; 4]) {
-    #[cfg(target_arch = "x86_64")]
-    if is_x86_feature_detected!("avx2") {
-        let [x0, y0, x1, y1] = rect;
-        let n = x1 - x0;
-        for y in y0..y1 {
-            let a = &src[2 * y * sw + 2 * x0..][..2 * n];
-            let b = &src[(2 * y + 1) * sw + 2 * x0..][..2 * n];
-            let d = &mut dst[y * lw + x0..y * lw + x1];
-            // SAFETY: AVX2 detected; the kernel reads and writes inside the three slices.
-            let done = unsafe { sum4_u16_row_avx2(a, b, d) };
-            for i in done..n {
-                d[i] = a[2 * i] + a[2 * i + 1] + b[2 * i] + b[2 * i + 1];
-            }
-        }
-        return;
-    }
-    sum4(src, sw, dst, lw, rect)
-}
-
 /// Sums of 2x2 words of rows `a` and `b` into `d`, 16 at a time (the column sums below 2^15,
 /// as signed words for `madd`); returns how many were done.
 ///
@@ -1370,17 +1327,52 @@ unsafe fn sum4_u16_row_avx2(a: &[u16], b: &[u16], d: &mut [u16]) -> usize {
     }
 }
 
+/// What the u16 box-sum pyramid is summed from: u8 pixels or u16 sums of 4^(l-1) pixels
+/// (l <= 4, so every column sum stays below 2^15 until the last pair).
+trait SumTexel: Copy + Into<u16> {
+    /// A kernel for the leading texels of a row (it returns how many it did), when the CPU
+    /// has what it needs.
+    fn row_kernel() -> Option<RowKernel<Self>>;
+}
+
+/// Sums of 2x2 elements of rows `a` and `b` into `d`; returns how many were done.
+type RowKernel<T> = unsafe fn(&[T], &[T], &mut [u16]) -> usize;
+
+impl SumTexel for u8 {
+    fn row_kernel() -> Option<RowKernel<u8>> {
+        #[cfg(target_arch = "x86_64")]
+        if is_x86_feature_detected!("avx2") {
+            return Some(sum4_row_avx2 as RowKernel<u8>);
+        }
+        None
+    }
+}
+
+impl SumTexel for u16 {
+    fn row_kernel() -> Option<RowKernel<u16>> {
+        #[cfg(target_arch = "x86_64")]
+        if is_x86_feature_detected!("avx2") {
+            return Some(sum4_u16_row_avx2 as RowKernel<u16>);
+        }
+        None
+    }
+}
+
 /// One level of the u16 box-sum pyramid: texels `rect` of `dst` (rows of `lw`) are the sums
-/// of 2x2 elements of `src` (rows of `sw`).
-fn sum4<T: Copy + Into<u16>>(src: &[T], sw: usize, dst: &mut [u16], lw: usize, rect: [usize; 4]) {
+/// of 2x2 elements of `src` (rows of `sw`); 16 texels per step with AVX2 where the CPU has it.
+fn sum4<T: SumTexel>(src: &[T], sw: usize, dst: &mut [u16], lw: usize, rect: [usize; 4]) {
     let [x0, y0, x1, y1] = rect;
     let n = x1 - x0;
+    let kernel = T::row_kernel();
     for y in y0..y1 {
         let a = &src[2 * y * sw + 2 * x0..][..2 * n];
         let b = &src[(2 * y + 1) * sw + 2 * x0..][..2 * n];
         let d = &mut dst[y * lw + x0..y * lw + x1];
-        for ((o, p), q) in d.iter_mut().zip(a.chunks_exact(2)).zip(b.chunks_exact(2)) {
-            *o = p[0].into() + p[1].into() + q[0].into() + q[1].into();
+        // SAFETY: a kernel is only given when the CPU has its features; it stays inside the
+        // three slices.
+        let done = kernel.map_or(0, |k| unsafe { k(a, b, d) });
+        for i in done..n {
+            d[i] = a[2 * i].into() + a[2 * i + 1].into() + b[2 * i].into() + b[2 * i + 1].into();
         }
     }
 }

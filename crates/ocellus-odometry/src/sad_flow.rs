@@ -125,6 +125,69 @@ fn search_scalar(
     (worst > best).then_some(at)
 }
 
+/// The running best offset of a block search over rows of 16 costs (offsets 0..8 and 8..16
+/// of one vertical offset; those past `span` ignored), first in raster order on ties, and
+/// the largest cost (a flat window costs the same everywhere).
+#[cfg(target_arch = "x86_64")]
+struct BestOffset {
+    outside: std::arch::x86_64::__m128i,
+    best: u32,
+    at: (usize, usize),
+    hi: std::arch::x86_64::__m128i,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl BestOffset {
+    /// # Safety
+    /// SSE4.1 must be available.
+    #[target_feature(enable = "sse4.1")]
+    unsafe fn new(span: usize) -> Self {
+        use std::arch::x86_64::*;
+        let lanes = _mm_setr_epi16(8, 9, 10, 11, 12, 13, 14, 15);
+        Self {
+            outside: _mm_cmpgt_epi16(lanes, _mm_set1_epi16(span as i16 - 1)),
+            best: u32::MAX,
+            at: (0, 0),
+            hi: _mm_setzero_si128(),
+        }
+    }
+
+    /// The costs of vertical offset `oy`: horizontal offsets 0..8 in `lo`, 8..16 in `up`.
+    ///
+    /// # Safety
+    /// SSE4.1 must be available.
+    #[target_feature(enable = "sse4.1")]
+    #[inline]
+    unsafe fn row(&mut self, oy: usize, lo: std::arch::x86_64::__m128i, up: std::arch::x86_64::__m128i) {
+        use std::arch::x86_64::*;
+        // Offsets past `span` in the second half are masked to the maximum.
+        let halves = [lo, _mm_or_si128(up, self.outside)];
+        for (h, v) in halves.iter().enumerate() {
+            let m = _mm_minpos_epu16(*v);
+            let val = _mm_extract_epi16::<0>(m) as u32;
+            if val < self.best {
+                self.best = val;
+                self.at = (8 * h + _mm_extract_epi16::<1>(m) as usize, oy);
+            }
+        }
+        self.hi = _mm_max_epu16(self.hi, lo);
+        self.hi = _mm_max_epu16(self.hi, _mm_andnot_si128(self.outside, up));
+    }
+
+    /// The best offset, or `None` when every cost was the same.
+    ///
+    /// # Safety
+    /// SSE4.1 must be available.
+    #[target_feature(enable = "sse4.1")]
+    unsafe fn result(&self) -> Option<(usize, usize)> {
+        use std::arch::x86_64::*;
+        // Flat: the largest cost equals the smallest.
+        let worst =
+            0xffff - _mm_extract_epi16::<0>(_mm_minpos_epu16(_mm_sub_epi16(_mm_set1_epi16(-1), self.hi))) as u32;
+        (worst > self.best).then_some(self.at)
+    }
+}
+
 /// [`search_scalar`] for 8x8 blocks and up to 16 offsets per axis with SSE4.1's `mpsadbw`
 /// (eight 4-byte SADs at consecutive offsets per instruction) and `phminposuw`.
 ///
@@ -164,27 +227,11 @@ unsafe fn search_8x8_sse41(
                 );
             }
         }
-        // Offsets past `span` in the second half are masked to the maximum.
-        let lanes = _mm_setr_epi16(8, 9, 10, 11, 12, 13, 14, 15);
-        let outside = _mm_cmpgt_epi16(lanes, _mm_set1_epi16(span as i16 - 1));
-        let (mut best, mut at) = (u32::MAX, (0usize, 0usize));
-        let mut hi = _mm_setzero_si128();
+        let mut best = BestOffset::new(span);
         for (oy, a) in acc.iter().enumerate().take(span) {
-            let halves = [a[0], _mm_or_si128(a[1], outside)];
-            for (h, v) in halves.iter().enumerate() {
-                let m = _mm_minpos_epu16(*v);
-                let val = _mm_extract_epi16::<0>(m) as u32;
-                if val < best {
-                    best = val;
-                    at = (8 * h + _mm_extract_epi16::<1>(m) as usize, oy);
-                }
-            }
-            hi = _mm_max_epu16(hi, a[0]);
-            hi = _mm_max_epu16(hi, _mm_andnot_si128(outside, a[1]));
+            best.row(oy, a[0], a[1]);
         }
-        // Flat: the largest cost equals the smallest.
-        let worst = 0xffff - _mm_extract_epi16::<0>(_mm_minpos_epu16(_mm_sub_epi16(_mm_set1_epi16(-1), hi))) as u32;
-        (worst > best).then_some(at)
+        best.result()
     }
 }
 
@@ -213,10 +260,7 @@ unsafe fn search_8x8_avx2(
         let brows: [__m256i; 8] = std::array::from_fn(|r| {
             _mm256_broadcastsi128_si256(_mm_loadl_epi64(prev.row(by + r)[bx..bx + 8].as_ptr() as *const __m128i))
         });
-        let lanes = _mm_setr_epi16(8, 9, 10, 11, 12, 13, 14, 15);
-        let outside = _mm_cmpgt_epi16(lanes, _mm_set1_epi16(span as i16 - 1));
-        let (mut best, mut at) = (u32::MAX, (0usize, 0usize));
-        let mut hi = _mm_setzero_si128();
+        let mut best = BestOffset::new(span);
         for oy in 0..span {
             let mut a = _mm256_setzero_si256();
             for (r, brow) in brows.iter().enumerate() {
@@ -232,21 +276,9 @@ unsafe fn search_8x8_avx2(
                     ),
                 );
             }
-            let (lo, up) = (_mm256_castsi256_si128(a), _mm256_extracti128_si256::<1>(a));
-            let halves = [lo, _mm_or_si128(up, outside)];
-            for (h, v) in halves.iter().enumerate() {
-                let m = _mm_minpos_epu16(*v);
-                let val = _mm_extract_epi16::<0>(m) as u32;
-                if val < best {
-                    best = val;
-                    at = (8 * h + _mm_extract_epi16::<1>(m) as usize, oy);
-                }
-            }
-            hi = _mm_max_epu16(hi, lo);
-            hi = _mm_max_epu16(hi, _mm_andnot_si128(outside, up));
+            best.row(oy, _mm256_castsi256_si128(a), _mm256_extracti128_si256::<1>(a));
         }
-        let worst = 0xffff - _mm_extract_epi16::<0>(_mm_minpos_epu16(_mm_sub_epi16(_mm_set1_epi16(-1), hi))) as u32;
-        (worst > best).then_some(at)
+        best.result()
     }
 }
 

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Issue 7's baseline on this machine: OpenCV pyramidal LK + RANSAC partial affine
+# (lk_odometry.py) against `ocellus odometry` (robust mode) on the generated floors, 3 seeds,
+# easy and hard. Prints one line per run: texture variant seed, then final drift % of the path
+# and final heading error (degrees) of each. Needs the venv of run.sh (network once).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+source scripts/opencv/venv.sh
+O=target/release/ocellus
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
+drift() { "$O" odometry eval "$1" "$2" --plot "$T/plot.png" | awk '/final drift/ {printf "%s %s", $3, $11}'; }
+echo "texture variant seed | lk_drift_% lk_heading_deg lk_ms | ocellus_drift_% ocellus_heading_deg"
+for tex in brick grass gravel mosaic; do
+  for variant in easy hard; do
+    for seed in 1 2 3; do
+      flag=""; [ "$variant" = hard ] && flag="--hard"
+      "$O" synth ground --texture "$tex" --seed "$seed" $flag --out "$T/seq" > /dev/null
+      ms=$("$PY" scripts/opencv/lk_odometry.py "$T/seq/frames" "$T/seq/camera.toml" "$T/lk.tum" | awk '{print $1}')
+      "$O" odometry "$T/seq/frames" --camera "$T/seq/camera.toml" --out "$T/ours" > /dev/null
+      echo "$tex $variant $seed | $(drift "$T/lk.tum" "$T/seq/groundtruth.tum") $ms | $(drift "$T/ours/trajectory.tum" "$T/seq/groundtruth.tum")"
+      rm -rf "$T/seq" "$T/ours"
+    done
+  done
+done
