@@ -105,6 +105,10 @@ impl LogPolarConfig {
         if self.rings > 65_536 || self.sectors > 65_536 || self.fovea_rings > 65_536 {
             return bad(format!("{} rings, {} sectors: at most 65536", self.rings, self.sectors));
         }
+        let cells = (self.rings + self.fovea_rings) * self.sectors;
+        if cells > 1 << 24 {
+            return bad(format!("{cells} cells (rings x sectors): at most 2^24"));
+        }
         if !(self.fovea_radius.is_finite() && self.fovea_radius > 0.0) {
             return bad(format!("fovea radius {} px must be positive", self.fovea_radius));
         }
@@ -1457,6 +1461,21 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn huge_or_degenerate_maps_are_refused_with_a_reason() {
+        let base = LogPolarConfig::for_image(64, 64);
+        for (cfg, why) in [
+            (LogPolarConfig { rings: 60_000, sectors: 60_000, ..base }, "cells"),
+            (LogPolarConfig { max_radius: 1.0, ..base }, "outer radius"),
+            (LogPolarConfig { centre: [f64::NAN, 3.0], ..base }, "gaze"),
+            (LogPolarConfig { max_level: 5, ..base }, "level"),
+        ] {
+            let e = LogPolarMap::new(&cfg, 64, 64).unwrap_err().to_string();
+            assert!(e.contains(why), "{e}");
+        }
+        assert!(LogPolarMap::new(&base, 0, 64).is_err());
     }
 
     #[test]
