@@ -183,10 +183,47 @@ pub fn warp_similarity(img: &Plane<f32>, angle: f64, scale: f64) -> Plane<f32> {
     Plane::from_fn(w, h, |x, y| {
         let (dx, dy) = (x as f64 - cx, y as f64 - cy);
         let (u, v) = ((c * dx + s * dy) / scale + cx, (-s * dx + c * dy) / scale + cy);
-        if u < 0.0 || v < 0.0 || u > (w - 1) as f64 || v > (h - 1) as f64 {
+        // A hair of tolerance: a half turn maps the border onto itself up to rounding.
+        let e = 1e-6;
+        if u < -e || v < -e || u > (w - 1) as f64 + e || v > (h - 1) as f64 + e {
             0.0
         } else {
             ocellus_image::resample::sample_bilinear(img, u as f32, v as f32)
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bad_inputs_are_errors_not_panics() {
+        let a = Plane::from_fn(64, 48, |x, y| ((x * 7 + y * 3) % 50) as f32);
+        let opts = RegisterOptions::default();
+        assert!(register(&a, &Plane::new(64, 47), &opts).is_err());
+        assert!(register(&Plane::new(8, 8), &Plane::new(8, 8), &opts).is_err());
+        let mut nan = a.clone();
+        nan.set(3, 3, f32::NAN);
+        assert!(register(&a, &nan, &opts).is_err());
+        assert!(register(&a, &a, &RegisterOptions { radius_ratio: 1.0, ..opts }).is_err());
+        // Flat images have nothing to correlate.
+        let flat = Plane::from_fn(64, 48, |_, _| 3.0f32);
+        for mode in [Mode::Direct, Mode::Spectrum] {
+            assert!(register(&flat, &flat, &RegisterOptions { mode, ..opts }).is_err(), "{mode:?}");
+        }
+    }
+
+    #[test]
+    fn a_warp_by_zero_is_the_identity_and_a_half_turn_reverses() {
+        let a = Plane::from_fn(31, 21, |x, y| (x * 3 + y * 5) as f32);
+        let same = warp_similarity(&a, 0.0, 1.0);
+        let half = warp_similarity(&a, PI, 1.0);
+        for y in 0..21 {
+            for x in 0..31 {
+                assert!((same.get(x, y) - a.get(x, y)).abs() < 1e-3);
+                assert!((half.get(x, y) - a.get(30 - x, 20 - y)).abs() < 1e-2, "{x} {y}");
+            }
+        }
+    }
 }

@@ -59,7 +59,8 @@ fn ncc(a: &Plane<f32>, b: &Plane<f32>) -> f64 {
             sbb += y * y;
         }
     }
-    if saa <= 0.0 || sbb <= 0.0 {
+    // A (nearly) flat field has no pattern to correlate: rounding noise must not score.
+    if saa <= 1e-6 * n || sbb <= 1e-6 * n {
         0.0
     } else {
         sab / (saa * sbb).sqrt()
@@ -134,4 +135,34 @@ pub fn vergence(left: &Plane<u8>, right: &Plane<u8>, gaze: [f64; 2], opts: &Verg
         }
     }
     Ok(Vergence { disparity_px: d, score: best })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ocellus_image::rng::SplitMix64;
+
+    #[test]
+    fn a_shifted_random_texture_gives_its_shift_and_bad_input_errors() {
+        let mut rng = SplitMix64::new(4);
+        let (w, h) = (160, 100);
+        // Smooth random texture: 3x3 box of white noise.
+        let noise = Plane::from_fn(w + 2, h + 2, |_, _| rng.below(256) as f32);
+        let left = Plane::from_fn(w, h, |x, y| {
+            let s: f32 = (0..3).flat_map(|j| (0..3).map(move |i| (i, j))).map(|(i, j)| noise.get(x + i, y + j)).sum();
+            (s / 9.0) as u8
+        });
+        // Right image: the left moved 13 px to the left (disparity 13).
+        let right = Plane::from_fn(w, h, |x, y| left.get((x + 13).min(w - 1), y));
+        let v = vergence(&left, &right, [90.0, 50.0], &VergenceOptions::default()).unwrap();
+        assert!((v.disparity_px - 13.0).abs() < 0.1 && v.score > 0.99, "{v:?}");
+        let opts = VergenceOptions::default();
+        assert!(vergence(&left, &right, [-1.0, 50.0], &opts).is_err());
+        assert!(vergence(&left, &right, [f64::NAN, 50.0], &opts).is_err());
+        assert!(vergence(&left, &Plane::new(w, h - 1), [90.0, 50.0], &opts).is_err());
+        assert!(vergence(&left, &right, [90.0, 50.0], &VergenceOptions { min_disparity: 5, max_disparity: 2, ..opts })
+            .is_err());
+        let flat = Plane::from_fn(w, h, |_, _| 9u8);
+        assert!(vergence(&flat, &flat, [90.0, 50.0], &opts).is_err());
+    }
 }
