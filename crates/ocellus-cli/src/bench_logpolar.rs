@@ -4,7 +4,7 @@ use crate::bench::median;
 use anyhow::{Context, Result};
 use ocellus_fovea::logpolar::{Fields, LogPolarConfig, LogPolarMap, Scratch};
 use ocellus_fovea::register::{register, Mode, RegisterOptions};
-use ocellus_fovea::vergence::{vergence, VergenceOptions};
+use ocellus_fovea::vergence::{vergence, VergenceOptions, VergenceTracker};
 use ocellus_image::Plane;
 use serde_json::json;
 use std::time::Instant;
@@ -80,6 +80,16 @@ pub fn run(json_out: bool) -> Result<()> {
         t.push(s.elapsed().as_secs_f64() * 1e3);
     }
     figures.insert("ms_vergence_65_disparities".into(), json!(median(&mut t)));
+    // Tracking: each frame searches 4 px around the last disparity (9 candidates).
+    let mut tracker = VergenceTracker::new(VergenceOptions::default(), 4, 0.8)?;
+    tracker.update(&photo, &right, [300.0, 250.0])?;
+    let mut t = Vec::new();
+    for _ in 0..20 {
+        let s = Instant::now();
+        tracker.update(&photo, &right, [300.0, 250.0])?;
+        t.push(s.elapsed().as_secs_f64() * 1e3);
+    }
+    figures.insert("ms_vergence_tracked_frame".into(), json!(median(&mut t)));
     let v = serde_json::Value::Object(figures);
     if json_out {
         println!("{v}");

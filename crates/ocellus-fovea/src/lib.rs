@@ -12,7 +12,8 @@
 //!   space (directly about the centres, or on the magnitude spectra for translation
 //!   invariance: Fourier-Mellin).
 //! - [`vergence`]: the horizontal disparity at the gaze point of a stereo pair, from the
-//!   log-polar images, for binocular tracking.
+//!   log-polar images; [`vergence::VergenceTracker`] follows it over a stereo stream for
+//!   binocular tracking.
 //!
 //! Conventions: image x right, y down; pixel (x, y) has its centre at (x, y) (the
 //! convention of [`ocellus_image::resample::sample_bilinear`]). Angles are measured from +x

@@ -85,19 +85,30 @@ pub fn vergence(left: &Plane<u8>, right: &Plane<u8>, gaze: [f64; 2], opts: &Verg
     if !(gx.is_finite() && gy.is_finite() && gx >= 0.0 && gy >= 0.0 && gx <= (w - 1) as f64 && gy <= (h - 1) as f64) {
         return Err(FoveaError::Invalid(format!("gaze point ({gx}, {gy}) outside the {w}x{h} image")));
     }
-    let (gx, gy) = (gx.round(), gy.round());
-    let cfg = LogPolarConfig {
+    let map = LogPolarMap::new(&foveal_config(opts, [gx.round(), gy.round()]), w, h)?;
+    search(&map, left, right, opts)
+}
+
+/// The foveal map of `opts` about `centre` (whole pixels, so it can be moved without a rebuild).
+fn foveal_config(opts: &VergenceOptions, centre: [f64; 2]) -> LogPolarConfig {
+    LogPolarConfig {
         rings: opts.rings,
         sectors: opts.sectors,
         fovea_rings: opts.fovea_radius.round().max(1.0) as usize,
         fovea_radius: opts.fovea_radius,
         max_radius: opts.max_radius,
-        centre: [gx, gy],
+        centre,
         max_level: 0,
         min_field_texels: 1.0,
         fields: Fields::Area,
-    };
-    let map = LogPolarMap::new(&cfg, w, h)?;
+    }
+}
+
+/// The disparity search with the left eye's foveal `map` (built for this image size).
+fn search(map: &LogPolarMap, left: &Plane<u8>, right: &Plane<u8>, opts: &VergenceOptions) -> Result<Vergence> {
+    let (w, h) = left.size();
+    let cfg = *map.config();
+    let [gx, gy] = cfg.centre;
     let mut scratch = Scratch::default();
     let mut lcortex = Plane::default();
     map.sample_grey_into(left, &mut scratch, &mut lcortex)?;
@@ -137,21 +148,113 @@ pub fn vergence(left: &Plane<u8>, right: &Plane<u8>, gaze: [f64; 2], opts: &Verg
     Ok(Vergence { disparity_px: d, score: best })
 }
 
+/// Vergence over a stereo stream, for binocular tracking: the disparity at a fixated target
+/// changes little from frame to frame, so each frame searches only `window` pixels around the
+/// last estimate, and the whole range again when the match is lost (the best disparity on the
+/// window's edge, or a correlation below `min_score`).
+#[derive(Clone, Debug)]
+pub struct VergenceTracker {
+    opts: VergenceOptions,
+    window: i64,
+    min_score: f64,
+    last: Option<f64>,
+    full_searches: usize,
+    /// The left eye's foveal map for the last gaze point (rounded) and image size.
+    map: Option<LogPolarMap>,
+}
+
+impl VergenceTracker {
+    /// A tracker searching `window` px around the last disparity (full range `opts`), trusting
+    /// correlations of at least `min_score`.
+    pub fn new(opts: VergenceOptions, window: i64, min_score: f64) -> Result<Self> {
+        if window < 1 || !(min_score.is_finite() && min_score <= 1.0) {
+            return Err(FoveaError::Invalid(format!("window {window} px (>= 1), min score {min_score} (<= 1)")));
+        }
+        Ok(Self { opts, window, min_score, last: None, full_searches: 0, map: None })
+    }
+
+    /// The disparity at `gaze` in this frame pair.
+    pub fn update(&mut self, left: &Plane<u8>, right: &Plane<u8>, gaze: [f64; 2]) -> Result<Vergence> {
+        // Checks the inputs, and the full search when there is nothing to follow.
+        let full = |t: &mut Self| -> Result<Vergence> {
+            t.full_searches += 1;
+            t.last = None;
+            let v = vergence(left, right, gaze, &t.opts)?;
+            t.last = Some(v.disparity_px);
+            Ok(v)
+        };
+        if left.size() != right.size() {
+            return full(self);
+        }
+        let centre = [gaze[0].round(), gaze[1].round()];
+        let reuse = self.map.as_ref().is_some_and(|m| m.config().centre == centre && m.image_size() == left.size());
+        if !reuse {
+            self.map = None;
+            let v = full(self)?;
+            self.map = Some(LogPolarMap::new(&foveal_config(&self.opts, centre), left.width(), left.height())?);
+            return Ok(v);
+        }
+        if let (Some(d), Some(map)) = (self.last, &self.map) {
+            let c = d.round() as i64;
+            let (lo, hi) =
+                ((c - self.window).max(self.opts.min_disparity), (c + self.window).min(self.opts.max_disparity));
+            let near = VergenceOptions { min_disparity: lo, max_disparity: hi, ..self.opts };
+            if let Ok(v) = search(map, left, right, &near) {
+                let on_edge = (lo > self.opts.min_disparity && v.disparity_px < lo as f64 + 0.5)
+                    || (hi < self.opts.max_disparity && v.disparity_px > hi as f64 - 0.5);
+                if v.score >= self.min_score && !on_edge {
+                    self.last = Some(v.disparity_px);
+                    return Ok(v);
+                }
+            }
+        }
+        full(self)
+    }
+
+    /// How many frames needed the full search (the first, and each time the target was lost).
+    pub fn full_searches(&self) -> usize {
+        self.full_searches
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use ocellus_image::rng::SplitMix64;
 
-    #[test]
-    fn a_shifted_random_texture_gives_its_shift_and_bad_input_errors() {
-        let mut rng = SplitMix64::new(4);
-        let (w, h) = (160, 100);
-        // Smooth random texture: 3x3 box of white noise.
+    fn texture(seed: u64, w: usize, h: usize) -> Plane<u8> {
+        let mut rng = SplitMix64::new(seed);
         let noise = Plane::from_fn(w + 2, h + 2, |_, _| rng.below(256) as f32);
-        let left = Plane::from_fn(w, h, |x, y| {
+        Plane::from_fn(w, h, |x, y| {
             let s: f32 = (0..3).flat_map(|j| (0..3).map(move |i| (i, j))).map(|(i, j)| noise.get(x + i, y + j)).sum();
             (s / 9.0) as u8
-        });
+        })
+    }
+
+    #[test]
+    fn the_tracker_follows_a_drifting_disparity_and_recovers_from_a_jump() {
+        let (w, h) = (200, 100);
+        let left = texture(6, w, h);
+        let mut tracker = VergenceTracker::new(VergenceOptions::default(), 4, 0.8).unwrap();
+        // The target approaches (disparity 10 -> 28 in steps of 2), then the gaze jumps to a
+        // far surface (disparity 3).
+        let mut disparities: Vec<usize> = (10..=28).step_by(2).collect();
+        disparities.push(3);
+        for &d in &disparities {
+            let right = Plane::from_fn(w, h, |x, y| left.get((x + d).min(w - 1), y));
+            let v = tracker.update(&left, &right, [120.0, 50.0]).unwrap();
+            assert!((v.disparity_px - d as f64).abs() < 0.1, "{d}: {v:?}");
+        }
+        assert_eq!(tracker.full_searches(), 2, "the first frame and after the jump");
+        assert!(tracker.update(&left, &Plane::new(w, h - 1), [120.0, 50.0]).is_err());
+        assert!(VergenceTracker::new(VergenceOptions::default(), 0, 0.8).is_err());
+    }
+
+    #[test]
+    fn a_shifted_random_texture_gives_its_shift_and_bad_input_errors() {
+        let (w, h) = (160, 100);
+        // Smooth random texture: 3x3 box of white noise.
+        let left = texture(4, w, h);
         // Right image: the left moved 13 px to the left (disparity 13).
         let right = Plane::from_fn(w, h, |x, y| left.get((x + 13).min(w - 1), y));
         let v = vergence(&left, &right, [90.0, 50.0], &VergenceOptions::default()).unwrap();
