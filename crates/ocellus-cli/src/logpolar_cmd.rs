@@ -2,9 +2,11 @@
 //! `logpolar register A B`: rotation and scale between two images; `logpolar vergence L R`:
 //! disparity at a gaze point of a stereo pair.
 
+use crate::frames::for_each_frame;
+use crate::video_out::VideoWriter;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
-use ocellus_fovea::logpolar::{Fields, LogPolarConfig, LogPolarMap};
+use ocellus_fovea::logpolar::{Fields, LogPolarConfig, LogPolarMap, Scratch};
 use ocellus_fovea::register::{register, Mode, RegisterOptions};
 use ocellus_fovea::vergence::{vergence, VergenceOptions};
 use ocellus_image::Plane;
@@ -16,7 +18,8 @@ use std::path::{Path, PathBuf};
 pub struct LogPolarArgs {
     #[command(subcommand)]
     sub: Option<Sub>,
-    /// Input image (PNG, JPEG, PNM; colour is kept).
+    /// Input image (PNG, JPEG, PNM; colour is kept), or a folder of images, a Y4M file or a
+    /// video (every frame through the same map).
     #[arg(required = true)]
     image: Option<PathBuf>,
     /// Log rings between the fovea radius and the outer radius.
@@ -40,7 +43,8 @@ pub struct LogPolarArgs {
     fields: FieldsArg,
     /// Output folder: cortex.png (sectors across, rings down; fovea rings on top),
     /// inverse.png (the cortical image mapped back for display), logpolar.json (geometry and
-    /// compression ratio).
+    /// compression ratio). For a stream: cortex/NNNNN.png, and cortex.mp4 and inverse.mp4
+    /// when ffmpeg is installed.
     #[arg(long, default_value = "ocellus-logpolar")]
     out: PathBuf,
 }
@@ -127,21 +131,12 @@ pub fn run(a: LogPolarArgs) -> Result<()> {
         None => {}
     }
     let Some(path) = &a.image else { bail!("give an image") };
+    if path.is_dir() || !ocellus_io::is_image_path(path) {
+        return run_stream(&a, path);
+    }
     let img = ocellus_io::read_image(path)?;
     let (w, h) = img.size();
-    let mut cfg = LogPolarConfig { rings: a.rings, sectors: a.sectors, ..LogPolarConfig::for_image(w, h) };
-    if let Some(c) = a.fovea {
-        cfg.centre = c;
-    }
-    if let Some(r) = a.max_radius {
-        cfg.max_radius = r;
-    }
-    cfg.fovea_radius = a.fovea_radius.unwrap_or((cfg.max_radius / 60.0).max(2.0).min(cfg.max_radius / 2.0));
-    cfg.fovea_rings = cfg.fovea_radius.round().max(1.0) as usize;
-    cfg.fields = match a.fields {
-        FieldsArg::Pyramid => Fields::Pyramid,
-        FieldsArg::Area => Fields::Area,
-    };
+    let cfg = config(&a, w, h);
     let t = std::time::Instant::now();
     let map = LogPolarMap::new(&cfg, w, h)?;
     let build_ms = t.elapsed().as_secs_f64() * 1e3;
@@ -175,16 +170,109 @@ pub fn run(a: LogPolarArgs) -> Result<()> {
     Ok(())
 }
 
+/// The map's parameters for a `w` x `h` input from the options.
+fn config(a: &LogPolarArgs, w: usize, h: usize) -> LogPolarConfig {
+    let mut cfg = LogPolarConfig { rings: a.rings, sectors: a.sectors, ..LogPolarConfig::for_image(w, h) };
+    if let Some(c) = a.fovea {
+        cfg.centre = c;
+    }
+    if let Some(r) = a.max_radius {
+        cfg.max_radius = r;
+    }
+    cfg.fovea_radius = a.fovea_radius.unwrap_or((cfg.max_radius / 60.0).max(2.0).min(cfg.max_radius / 2.0));
+    cfg.fovea_rings = cfg.fovea_radius.round().max(1.0) as usize;
+    cfg.fields = match a.fields {
+        FieldsArg::Pyramid => Fields::Pyramid,
+        FieldsArg::Area => Fields::Area,
+    };
+    cfg
+}
+
+/// 8-bit RGB from three float planes (rounded, saturated).
+fn to_rgb8(p: [&Plane<f32>; 3]) -> Plane<[u8; 3]> {
+    let (pw, ph) = p[0].size();
+    Plane::from_fn(pw, ph, |x, y| p.map(|c| c.get(x, y).round().clamp(0.0, 255.0) as u8))
+}
+
+/// A folder of images, a Y4M file or a video: every frame through one map (built from the
+/// first frame's size); the cortical frames as PNG files, and as videos with their inverses
+/// when ffmpeg is installed.
+fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
+    let cortex_dir = a.out.join("cortex");
+    std::fs::create_dir_all(&cortex_dir).with_context(|| format!("cannot create {}", cortex_dir.display()))?;
+    let mut state: Option<(LogPolarMap, Scratch, Option<VideoWriter>, Option<VideoWriter>)> = None;
+    let (mut out, mut spent) = (Vec::new(), Vec::new());
+    let n = for_each_frame(input, None, |k, frame| {
+        let rgb = frame.to_u8();
+        let (w, h) = rgb.size();
+        if state.is_none() {
+            let map = LogPolarMap::new(&config(a, w, h), w, h)?;
+            let (cw, ch) = (map.sectors(), map.rows());
+            let cortex_video = VideoWriter::start(&a.out.join("cortex.mp4"), cw + cw % 2, ch + ch % 2, 30)?;
+            let inverse_video = VideoWriter::start(&a.out.join("inverse.mp4"), w + w % 2, h + h % 2, 30)?;
+            state = Some((map, Scratch::default(), cortex_video, inverse_video));
+        }
+        let Some((map, scratch, cortex_video, inverse_video)) = state.as_mut() else { bail!("no map") };
+        if (w, h) != map.image_size() {
+            bail!("frame is {w}x{h}, the first frame was {:?}", map.image_size());
+        }
+        let t = std::time::Instant::now();
+        map.sample_rgb_into(&rgb, scratch, &mut out)?;
+        spent.push(t.elapsed().as_secs_f64() * 1e6);
+        let cells = map.rows() * map.sectors();
+        let planes: Vec<Plane<f32>> = out
+            .chunks_exact(cells)
+            .map(|c| Plane::from_vec(map.sectors(), map.rows(), c.to_vec()))
+            .collect::<std::result::Result<_, _>>()?;
+        let [r, g, b] = [&planes[0], &planes[1], &planes[2]];
+        let cortex = to_rgb8([r, g, b]);
+        ocellus_io::write_png(cortex_dir.join(format!("{k:05}.png")), &ocellus_image::convert::to_image_rgb8(&cortex))?;
+        let even = |p: &Plane<[u8; 3]>| {
+            let (pw, ph) = p.size();
+            Plane::from_fn(pw + pw % 2, ph + ph % 2, |x, y| p.get(x.min(pw - 1), y.min(ph - 1)))
+        };
+        if let Some(v) = cortex_video.as_mut() {
+            v.write(&even(&cortex))?;
+        }
+        if let Some(v) = inverse_video.as_mut() {
+            let inverse = to_rgb8([&map.inverse(r)?, &map.inverse(g)?, &map.inverse(b)?]);
+            v.write(&even(&inverse))?;
+        }
+        Ok(())
+    })?;
+    let Some((map, _, cortex_video, inverse_video)) = state else { bail!("{} has no frames", input.display()) };
+    let videos = cortex_video.is_some();
+    for v in [cortex_video, inverse_video].into_iter().flatten() {
+        v.finish()?;
+    }
+    spent.sort_by(f64::total_cmp);
+    let median_us = spent.get(spent.len() / 2).copied().unwrap_or(0.0);
+    let info = serde_json::json!({
+        "frames": n,
+        "image": map.image_size(),
+        "config": map.config(),
+        "cortex_rows": map.rows(),
+        "cortex_columns": map.sectors(),
+        "compression_ratio": map.compression_ratio(),
+        "median_rgb_sample_us": median_us,
+    });
+    std::fs::write(a.out.join("logpolar.json"), serde_json::to_string_pretty(&info)?)?;
+    println!(
+        "{n} frames -> {} rows x {} sectors, {median_us:.0} us per frame (median, sampling only); wrote cortex/NNNNN.png{}, logpolar.json in {}",
+        map.rows(),
+        map.sectors(),
+        if videos { ", cortex.mp4, inverse.mp4" } else { " (no ffmpeg: no videos)" },
+        a.out.display()
+    );
+    Ok(())
+}
+
 /// Writes the cortical image of `rgb` under `map` and its inverse as PNG files.
 pub fn write_foveated(map: &LogPolarMap, rgb: &Plane<[u8; 3]>, cortex_png: &Path, inverse_png: &Path) -> Result<()> {
     let [r, g, b] = map.sample_rgb(rgb)?;
-    let to_rgb = |p: [&Plane<f32>; 3]| {
-        let (pw, ph) = p[0].size();
-        Plane::from_fn(pw, ph, |x, y| p.map(|c| c.get(x, y).round().clamp(0.0, 255.0) as u8))
-    };
-    ocellus_io::write_png(cortex_png, &ocellus_image::convert::to_image_rgb8(&to_rgb([&r, &g, &b])))?;
+    ocellus_io::write_png(cortex_png, &ocellus_image::convert::to_image_rgb8(&to_rgb8([&r, &g, &b])))?;
     let (ir, ig, ib) = (map.inverse(&r)?, map.inverse(&g)?, map.inverse(&b)?);
-    ocellus_io::write_png(inverse_png, &ocellus_image::convert::to_image_rgb8(&to_rgb([&ir, &ig, &ib])))?;
+    ocellus_io::write_png(inverse_png, &ocellus_image::convert::to_image_rgb8(&to_rgb8([&ir, &ig, &ib])))?;
     Ok(())
 }
 

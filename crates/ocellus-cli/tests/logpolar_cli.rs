@@ -45,3 +45,33 @@ fn logpolar_writes_the_cortex_its_inverse_and_the_geometry() {
     let o = ocellus().arg("logpolar").arg(&img).args(["--sectors", "0"]).output().unwrap();
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("sectors"));
 }
+
+#[test]
+fn logpolar_runs_every_frame_of_a_folder_through_one_map() {
+    let base = std::env::temp_dir().join(format!("ocellus-cli-{}-logpolar-stream", std::process::id()));
+    let _ = std::fs::remove_dir_all(&base);
+    let (frames, out) = (base.join("frames"), base.join("out"));
+    std::fs::create_dir_all(&frames).unwrap();
+    for k in 0..3 {
+        std::fs::copy(ocellus_testdata::asset("chelsea.png"), frames.join(format!("f{k}.png"))).unwrap();
+    }
+    let o = ocellus()
+        .arg("logpolar")
+        .arg(&frames)
+        .args(["--rings", "32", "--sectors", "48", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for k in 0..3 {
+        let c = image::open(out.join(format!("cortex/{k:05}.png"))).unwrap();
+        assert_eq!(c.width(), 48);
+    }
+    // The same picture gives the same cortical image in every frame.
+    let (a, b) =
+        (image::open(out.join("cortex/00000.png")).unwrap(), image::open(out.join("cortex/00002.png")).unwrap());
+    assert_eq!(a.as_bytes(), b.as_bytes());
+    let info: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("logpolar.json")).unwrap()).unwrap();
+    assert_eq!(info["frames"].as_u64(), Some(3));
+}
