@@ -120,11 +120,14 @@ fn search(map: &LogPolarMap, left: &Plane<u8>, right: &Plane<u8>, opts: &Vergenc
             scores.push(f64::NEG_INFINITY);
             continue;
         }
-        let moved = match map.shifted(-d, 0) {
-            Some(m) => m,
-            None => LogPolarMap::new(&LogPolarConfig { centre: [rx, gy], ..cfg }, w, h)?,
-        };
-        moved.sample_grey_into(right, &mut scratch, &mut rcortex)?;
+        if !map.sample_grey_moved_into(right, (-d, 0), &mut scratch, &mut rcortex)? {
+            // Near the border the fields change: a map of their own.
+            LogPolarMap::new(&LogPolarConfig { centre: [rx, gy], ..cfg }, w, h)?.sample_grey_into(
+                right,
+                &mut scratch,
+                &mut rcortex,
+            )?;
+        }
         scores.push(ncc(&lcortex, &rcortex));
     }
     let (mut bi, mut best) = (usize::MAX, f64::NEG_INFINITY);

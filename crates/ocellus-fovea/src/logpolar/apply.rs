@@ -8,36 +8,36 @@ use super::{level_size, Fields, LogPolarMap, Scratch};
 
 impl LogPolarMap {
     /// Builds the box pyramid (means of 2^l x 2^l pixels) of `src` (C interleaved channels)
-    /// up to the coarsest level a field reads, then applies the table.
-    pub(super) fn apply<T: Texel, const C: usize>(&self, src: &[T], scratch: &mut Scratch, out: &mut [f32]) {
+    /// up to the coarsest level a field reads, then applies the table. Full-resolution reads
+    /// are moved by `moved` pixels (a gaze point moved by whole pixels, see
+    /// [`LogPolarMap::sample_grey_moved_into`]; 0 otherwise).
+    pub(super) fn apply<T: Texel, const C: usize>(
+        &self,
+        src: &[T],
+        moved: isize,
+        scratch: &mut Scratch,
+        out: &mut [f32],
+    ) {
         let top = self.levels;
         if top > 0 {
-            let (w, h) = (self.width, self.height);
-            let total = self.level_base[top] + level_size(w, h, top).0 * level_size(w, h, top).1;
-            scratch.pyramid.resize(total * C, 0.0);
-            let [rx0, ry0, rx1, ry1] = self.pyramid_rect;
+            scratch.pyramid.resize(self.pyramid_len() * C, 0.0);
             for l in 1..=top {
-                let (pw, _) = level_size(w, h, l - 1);
-                let (lw, lh) = level_size(w, h, l);
-                // Texels of level l inside the rectangle.
-                let (tx0, ty0) = (rx0 >> l, ry0 >> l);
-                let (tx1, ty1) = ((rx1 >> l).min(lw), (ry1 >> l).min(lh));
-                if tx1 <= tx0 || ty1 <= ty0 {
-                    continue;
-                }
+                let Some(rect) = self.level_rect(l) else { continue };
+                let (pw, _) = level_size(self.width, self.height, l - 1);
+                let (lw, lh) = level_size(self.width, self.height, l);
                 let (lo, hi) = scratch.pyramid.split_at_mut(self.level_base[l] * C);
                 let dst = &mut hi[..lw * lh * C];
                 if l == 1 {
-                    halve::<T, C>(src, pw, dst, lw, [tx0, ty0, tx1, ty1], &mut scratch.row);
+                    halve::<T, C>(src, pw, dst, lw, rect, &mut scratch.row);
                 } else {
                     let prev = &lo[self.level_base[l - 1] * C..];
-                    halve::<f32, C>(prev, pw, dst, lw, [tx0, ty0, tx1, ty1], &mut scratch.row);
+                    halve::<f32, C>(prev, pw, dst, lw, rect, &mut scratch.row);
                 }
             }
         }
         let pyr = &scratch.pyramid;
         if self.cfg.fields == Fields::Pyramid {
-            self.apply_quads::<T, C>(src, pyr, out);
+            self.apply_quads::<T, C>(src, moved, pyr, out);
             return;
         }
         for (c, o) in out.chunks_exact_mut(C).enumerate() {
@@ -46,7 +46,7 @@ impl LogPolarMap {
             let mut acc = [0.0f32; C];
             if self.level[c] == 0 {
                 for (&i, &w) in offs.iter().zip(ws) {
-                    let i = i as usize * C;
+                    let i = (i as isize + moved) as usize * C;
                     for ch in 0..C {
                         acc[ch] += w * src[i + ch].into();
                     }
@@ -64,12 +64,13 @@ impl LogPolarMap {
     }
 
     /// The [`Fields::Pyramid`] table: one bilinear quad per cell.
-    fn apply_quads<T: Texel, const C: usize>(&self, src: &[T], pyr: &[f32], out: &mut [f32]) {
+    fn apply_quads<T: Texel, const C: usize>(&self, src: &[T], moved: isize, pyr: &[f32], out: &mut [f32]) {
         let row_step: Vec<usize> = (0..=self.levels).map(|l| level_size(self.width, self.height, l).0 * C).collect();
         for ((((o, &b), &fx), &fy), &l) in
             out.chunks_exact_mut(C).zip(&self.quad_base).zip(&self.quad_fx).zip(&self.quad_fy).zip(&self.level)
         {
-            let (i, dy) = (b as usize * C, row_step.get(l as usize).copied().unwrap_or(0));
+            let b = if l == 0 { (b as isize + moved) as usize } else { b as usize };
+            let (i, dy) = (b * C, row_step.get(l as usize).copied().unwrap_or(0));
             let last = i + dy + 2 * C - 1;
             let in_bounds = if l == 0 { last < src.len() } else { last < pyr.len() };
             if !in_bounds {

@@ -400,28 +400,42 @@ impl LogPolarMap {
     /// fields too small for the pyramid) and the fields lie inside the image before and after
     /// the move. `None` otherwise (build a new map then).
     pub fn shifted(&self, dx: i64, dy: i64) -> Option<LogPolarMap> {
+        let delta = self.move_delta(dx, dy)? as i64;
+        let mut out = self.clone();
+        out.cfg.centre = [self.cfg.centre[0] + dx as f64, self.cfg.centre[1] + dy as f64];
+        for o in out.offset.iter_mut().chain(out.quad_base.iter_mut()) {
+            *o = (*o as i64 + delta) as u32;
+        }
+        Some(out)
+    }
+
+    /// The change of every full-resolution pixel index when the gaze point moves by whole
+    /// pixels (dx, dy), when the move keeps the table valid (see [`Self::shifted`]).
+    fn move_delta(&self, dx: i64, dy: i64) -> Option<isize> {
         let inside = |cx: f64, cy: f64| {
             let r = self.cfg.max_radius + 2.0;
             cx - r >= 0.0 && cy - r >= 0.0 && cx + r <= (self.width - 1) as f64 && cy + r <= (self.height - 1) as f64
         };
         let [cx, cy] = self.cfg.centre;
-        let (nx, ny) = (cx + dx as f64, cy + dy as f64);
-        if self.levels != 0 || !inside(cx, cy) || !inside(nx, ny) {
-            return None;
-        }
-        let delta = dy * self.width as i64 + dx;
-        let mut out = self.clone();
-        out.cfg.centre = [nx, ny];
-        for o in out.offset.iter_mut() {
-            *o = (*o as i64 + delta) as u32;
-        }
-        if !out.invalid.is_empty() {
-            return None;
-        }
-        for o in out.quad_base.iter_mut() {
-            *o = (*o as i64 + delta) as u32;
-        }
-        Some(out)
+        let movable = self.levels == 0 && self.invalid.is_empty() && inside(cx, cy);
+        (movable && inside(cx + dx as f64, cy + dy as f64)).then(|| (dy * self.width as i64 + dx) as isize)
+    }
+
+    /// [`Self::sample_grey_into`] with the gaze point moved by whole pixels (dx, dy): the same
+    /// table read at an offset, neither rebuilt nor copied (as [`Self::shifted`] copies it).
+    /// `Ok(false)`, and nothing written, where [`Self::shifted`] gives `None`.
+    pub fn sample_grey_moved_into(
+        &self,
+        img: &Plane<u8>,
+        (dx, dy): (i64, i64),
+        scratch: &mut Scratch,
+        out: &mut Plane<f32>,
+    ) -> Result<bool> {
+        self.check_size(img.width(), img.height())?;
+        let Some(delta) = self.move_delta(dx, dy) else { return Ok(false) };
+        out.resize(self.cfg.sectors, self.rows);
+        self.apply::<u8, 1>(&contiguous(img), delta, scratch, out_slice(out));
+        Ok(true)
     }
 
     /// A [`Fields::Pyramid`] cell: one bilinear sample of level `l` (`lw` x `lh` texels) at
@@ -536,7 +550,7 @@ impl LogPolarMap {
         let src = contiguous(img);
         let o = out_slice(out);
         if self.cfg.fields != Fields::Pyramid || !self.apply_grey_pyramid(&src, scratch, o) {
-            self.apply::<u8, 1>(&src, scratch, o);
+            self.apply::<u8, 1>(&src, 0, scratch, o);
         }
         Ok(())
     }
@@ -546,7 +560,7 @@ impl LogPolarMap {
         self.check_size(img.width(), img.height())?;
         let mut out = Plane::new(self.cfg.sectors, self.rows);
         let src = contiguous(img);
-        self.apply::<f32, 1>(&src, &mut Scratch::default(), out_slice(&mut out));
+        self.apply::<f32, 1>(&src, 0, &mut Scratch::default(), out_slice(&mut out));
         Ok(out)
     }
 
@@ -574,7 +588,7 @@ impl LogPolarMap {
         }
         let mut mixed = std::mem::take(&mut scratch.channels);
         mixed.resize(3 * cells, 0.0);
-        self.apply::<u8, 3>(flat, scratch, &mut mixed);
+        self.apply::<u8, 3>(flat, 0, scratch, &mut mixed);
         for (c, v) in mixed.chunks_exact(3).enumerate() {
             (out[c], out[cells + c], out[2 * cells + c]) = (v[0], v[1], v[2]);
         }

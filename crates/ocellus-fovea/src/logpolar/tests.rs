@@ -115,8 +115,13 @@ fn a_shifted_map_equals_one_built_at_the_new_gaze_point() {
     for (x, y) in a.rows().flatten().zip(b.rows().flatten()) {
         assert!((x - y).abs() < 1e-3, "{x} {y}");
     }
+    // Reading the table at an offset gives the same, without a copy.
+    let mut read = Plane::default();
+    assert!(map.sample_grey_moved_into(&img, (-17, 9), &mut Scratch::default(), &mut read).unwrap());
+    assert_eq!(read.to_vec(), a.to_vec());
     // Not when the fields would leave the image, nor for pyramid maps.
     assert!(map.shifted(-50, 0).is_none());
+    assert!(!map.sample_grey_moved_into(&img, (-50, 0), &mut Scratch::default(), &mut read).unwrap());
     let pyr = LogPolarMap::new(&LogPolarConfig { max_level: 3, fields: Fields::Pyramid, ..cfg }, w, h).unwrap();
     assert!(pyr.shifted(1, 0).is_none());
 }
