@@ -1,26 +1,11 @@
 //! `ocellus generate chessboard`, `calibrate chessboard|planar` and `undistort` as a user runs them.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
+mod common;
+use common::{ocellus, run, tmpdir};
+
 use ocellus_geometry::chessboard::{find_chessboard, ChessboardOptions};
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn ocellus() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_ocellus"))
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ocellus-calib-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(cmd: &mut Command) -> String {
-    let o = cmd.output().unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
+use std::path::Path;
 
 fn camera(path: &Path) -> toml::Value {
     toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()

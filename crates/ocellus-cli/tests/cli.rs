@@ -1,19 +1,11 @@
 //! The `ocellus` binary as a user runs it.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
+mod common;
+use common::{ocellus, tmpdir};
+
 use std::path::PathBuf;
 use std::process::Command;
-
-fn ocellus() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_ocellus"))
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ocellus-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 #[test]
 fn saliency_writes_maps_overlay_and_conspicuity() {

@@ -1,16 +1,12 @@
 //! `ocellus logpolar` as a user runs it.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
-use std::process::Command;
-
-fn ocellus() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_ocellus"))
-}
+mod common;
+use common::{ocellus, tmpdir};
 
 #[test]
 fn logpolar_writes_the_cortex_its_inverse_and_the_geometry() {
-    let out = std::env::temp_dir().join(format!("ocellus-cli-{}-logpolar", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
+    let out = tmpdir("logpolar");
     let img = ocellus_testdata::asset("chelsea.png");
     let o = ocellus()
         .arg("logpolar")
@@ -48,8 +44,7 @@ fn logpolar_writes_the_cortex_its_inverse_and_the_geometry() {
 
 #[test]
 fn logpolar_runs_every_frame_of_a_folder_through_one_map() {
-    let base = std::env::temp_dir().join(format!("ocellus-cli-{}-logpolar-stream", std::process::id()));
-    let _ = std::fs::remove_dir_all(&base);
+    let base = tmpdir("logpolar-stream");
     let (frames, out) = (base.join("frames"), base.join("out"));
     std::fs::create_dir_all(&frames).unwrap();
     for k in 0..3 {

@@ -1,25 +1,8 @@
 //! `ocellus synth ground`, `ocellus odometry` and `ocellus odometry eval` as a user runs them.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
-use std::path::PathBuf;
-use std::process::Command;
-
-fn ocellus() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_ocellus"))
-}
-
-fn tmpdir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("ocellus-odo-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn run(cmd: &mut Command) -> String {
-    let o = cmd.output().unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
+mod common;
+use common::{ocellus, run, tmpdir};
 
 #[test]
 fn generate_estimate_and_evaluate_a_ground_sequence() {
