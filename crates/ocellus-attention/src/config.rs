@@ -283,7 +283,7 @@ impl SaliencyConfig {
     }
 
     /// SaliencyToolbox 2.x `defaultSaliencyParams` (Walther & Koch 2006), as listed in
-    /// `shared/data/reference/README.md`: 7-tap pyramid, luminance intensity at the input,
+    /// `testdata/reference/README.md`: 7-tap pyramid, luminance intensity at the input,
     /// 9x9 Gabor (sigma 2.3333), nearest-neighbour across scale, border ramp of max/20,
     /// global inhibition 0.02 max, per-sub-feature weighting, final N to [0, 2].
     ///

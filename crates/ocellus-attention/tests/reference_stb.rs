@@ -1,4 +1,4 @@
-//! The `stb` preset against maps made by the SaliencyToolbox itself (shared/data/reference).
+//! The `stb` preset against maps made by the SaliencyToolbox itself (testdata/reference).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
 use ocellus_attention::{config::ChannelKind, SaliencyConfig, SaliencyEngine};

@@ -338,7 +338,7 @@ fn plan_corridor_writes_frames_csv_and_plots() {
 
 #[test]
 fn stereo_writes_disparity_depth_cloud_and_scores_against_truth() {
-    let d = ocellus_testdata::data_dir().expect("shared data");
+    let d = ocellus_testdata::data_dir();
     let out = tmpdir("stereo");
     let o = ocellus()
         .arg("stereo")

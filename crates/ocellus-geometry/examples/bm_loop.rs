@@ -1,5 +1,5 @@
 //! Runs block matching on the motorcycle pair repeatedly and prints the median time: a
-//! profiling aid (needs ../shared/data).
+//! profiling aid (reads testdata/).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 use ocellus_geometry::block_matching::{block_match, BlockMatching};
 

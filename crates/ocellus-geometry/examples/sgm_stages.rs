@@ -1,4 +1,4 @@
-//! Prints SGM stage times on the motorcycle pair (needs ../shared/data): a profiling aid.
+//! Prints SGM stage times on the motorcycle pair (reads testdata/): a profiling aid.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 use ocellus_geometry::sgm::{Sgm, SgmMatcher, SgmPaths};
 

@@ -66,7 +66,7 @@ fn clear_errors_for_bad_files() {
 
 #[test]
 fn npy_reads_fortran_order_and_round_trips() {
-    // The shared reference maps are Fortran-ordered float64.
+    // The reference maps are Fortran-ordered float64.
     let a = npy::read(data_file("reference/astronaut_stb_salmap_30x40.npy")).unwrap();
     assert_eq!(a.shape, vec![30, 40]);
     let mx = a.data.iter().cloned().fold(f64::MIN, f64::max);
