@@ -1,7 +1,7 @@
 //! `ocellus attend`: saliency, surprise, context chaos and attention over a video or image
 //! sequence, with overlays, a scanpath and per-frame context values.
 
-use crate::{config_file, frames, overlay, plot, video_out::VideoWriter};
+use crate::{config_file, frames, overlay, plot, ranges};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ocellus_attention::attention::{Fixation, Reason};
@@ -9,6 +9,7 @@ use ocellus_attention::stream::{StreamConfig, StreamEngine, StreamFrame};
 use ocellus_attention::surprise::SurpriseConfig;
 use ocellus_image::convert::{to_image_rgb8, RgbImage};
 use ocellus_image::Plane;
+use ocellus_io::video_writer::VideoWriter;
 use plotters::style::RGBColor;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -22,8 +23,9 @@ pub struct AttendArgs {
     /// right and down) for the ego-sphere; without it the camera is taken as still.
     #[arg(long)]
     pub pan_tilt: Option<PathBuf>,
-    /// Camera angle per pixel in degrees (0.1: 64 degrees across 640 pixels).
-    #[arg(long, default_value_t = 0.1)]
+    /// Camera angle per pixel in degrees (0.1: 64 degrees across 640 pixels). Range: above 0,
+    /// at most 10.
+    #[arg(long, default_value_t = 0.1, value_parser = ranges::above(0.0f32, 10.0))]
     pub deg_per_px: f32,
     /// Output folder.
     #[arg(long, default_value = "ocellus-attend")]
@@ -33,11 +35,11 @@ pub struct AttendArgs {
     /// Do not write per-frame overlay PNGs (the video, CSVs and plot are still written).
     #[arg(long)]
     pub no_overlays: bool,
-    /// Frame rate of the overlay video.
-    #[arg(long, default_value_t = 30)]
+    /// Frame rate of the overlay video, frames per second. Range: 1..=1000.
+    #[arg(long, default_value_t = 30, value_parser = ranges::within(1u32, 1000))]
     pub fps: u32,
-    /// Process at most N frames.
-    #[arg(long)]
+    /// Process at most N frames. Range: 1..=10000000.
+    #[arg(long, value_parser = ranges::within(1usize, 10_000_000))]
     pub limit: Option<usize>,
 }
 
@@ -160,7 +162,7 @@ impl Outputs {
         if k == 0 {
             self.video = VideoWriter::start(&self.dir.join("overlays.mp4"), img.width(), img.height(), fps)?;
             if self.video.is_none() {
-                eprintln!("note: ffmpeg not found; no overlays.mp4 (scripts/setup.sh installs it)");
+                errln!("note: ffmpeg not found; no overlays.mp4 (scripts/setup.sh installs it)");
             }
         }
         if let Some(v) = self.video.as_mut() {
@@ -230,7 +232,7 @@ fn composite(frame: &RgbImage, r: &StreamFrame, recent: &[Fixation]) -> Result<P
 pub fn run(a: AttendArgs) -> Result<()> {
     let out = a.out.clone();
     let (n, saccades, written) = run_quiet(a)?;
-    println!("{n} frames, {saccades} saccades; wrote {} in {}", written.join(", "), out.display());
+    outln!("{n} frames, {saccades} saccades; wrote {} in {}", written.join(", "), out.display());
     Ok(())
 }
 

@@ -1,6 +1,6 @@
 //! `ocellus bench`: the figures the issues ask for, printed as a table or one JSON object.
 
-use crate::assets;
+use crate::{assets, ranges};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use ocellus_attention::{SaliencyConfig, SaliencyEngine};
@@ -36,27 +36,61 @@ pub struct BenchArgs {
     /// Print one JSON object instead of a table.
     #[arg(long)]
     pub json: bool,
-    /// Frames timed on one thread (the median is reported).
-    #[arg(long, default_value_t = 300)]
-    pub frames: usize,
-    /// Frame width in pixels (the built-in images are resized to it).
-    #[arg(long, default_value_t = 640)]
-    pub width: u32,
-    /// Frame height in pixels.
-    #[arg(long, default_value_t = 480)]
-    pub height: u32,
-    /// Use this image (resized) instead of the built-in ones.
+    /// Frames timed on one thread (the median is reported) [default: 300; planning: at least
+    /// 100 decisions]. Saliency, attention and planning only. Range: 1..=100000.
+    #[arg(long, value_parser = ranges::within(1usize, 100_000))]
+    pub frames: Option<usize>,
+    /// Frame width in pixels (the built-in images are resized to it) [default: 640].
+    /// Saliency only. Range: 32..=8192.
+    #[arg(long, value_parser = ranges::within(32u32, 8192))]
+    pub width: Option<u32>,
+    /// Frame height in pixels [default: 480]. Saliency only. Range: 32..=8192.
+    #[arg(long, value_parser = ranges::within(32u32, 8192))]
+    pub height: Option<u32>,
+    /// Use this image (resized) instead of the built-in ones. Saliency only.
     #[arg(long)]
     pub image: Option<PathBuf>,
-    /// Presets to measure (default: ace2009 and stb).
+    /// Presets to measure (default: ace2009 and stb). Saliency only.
     #[arg(long, value_delimiter = ',')]
     pub preset: Vec<String>,
-    /// Kernel build: auto, scalar or avx2.
-    #[arg(long, default_value = "auto")]
-    pub backend: String,
+    /// Kernel build: auto, scalar or avx2 [default: auto]. Saliency only.
+    #[arg(long)]
+    pub backend: Option<String>,
+}
+
+impl BenchArgs {
+    /// Refuses the options `target` does not use, so that no figure is printed for a setting
+    /// that was silently ignored.
+    fn reject_unused(&self) -> Result<()> {
+        let given = [
+            ("--frames", self.frames.is_some()),
+            ("--width", self.width.is_some()),
+            ("--height", self.height.is_some()),
+            ("--image", self.image.is_some()),
+            ("--preset", !self.preset.is_empty()),
+            ("--backend", self.backend.is_some()),
+        ];
+        let used: &[&str] = match self.target {
+            Target::Saliency => &["--frames", "--width", "--height", "--image", "--preset", "--backend"],
+            Target::Attention | Target::Planning => &["--frames"],
+            Target::Geometry | Target::Odometry | Target::Logpolar => &[],
+        };
+        let unused: Vec<&str> = given.iter().filter(|(n, g)| *g && !used.contains(n)).map(|(n, _)| *n).collect();
+        if !unused.is_empty() {
+            let name = format!("{:?}", self.target).to_lowercase();
+            let takes = if used.is_empty() { "no options besides --json".to_string() } else { used.join(", ") };
+            bail!("bench {name} does not use {} (it takes {takes})", unused.join(", "));
+        }
+        Ok(())
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (self.width.unwrap_or(640), self.height.unwrap_or(480))
+    }
 }
 
 fn frames(a: &BenchArgs) -> Result<Vec<RgbImage>> {
+    let (width, height) = a.size();
     let decoded: Vec<image::DynamicImage> = match &a.image {
         Some(p) => vec![image::open(p).with_context(|| format!("cannot read {}", p.display()))?],
         None => {
@@ -66,9 +100,9 @@ fn frames(a: &BenchArgs) -> Result<Vec<RgbImage>> {
     decoded
         .iter()
         .map(|d| {
-            let r = image::imageops::resize(&d.to_rgb8(), a.width, a.height, image::imageops::FilterType::Triangle);
+            let r = image::imageops::resize(&d.to_rgb8(), width, height, image::imageops::FilterType::Triangle);
             let data = r.pixels().map(|p| p.0).collect();
-            Ok(RgbImage::U8(Plane::from_vec(a.width as usize, a.height as usize, data)?))
+            Ok(RgbImage::U8(Plane::from_vec(width as usize, height as usize, data)?))
         })
         .collect()
 }
@@ -174,19 +208,20 @@ fn throughput(cfg: &SaliencyConfig, frames: &[RgbImage], threads: usize, n: usiz
 
 /// Runs the subcommand.
 pub fn run(a: BenchArgs) -> Result<()> {
-    if a.frames == 0 {
-        bail!("--frames must be at least 1");
-    }
+    a.reject_unused()?;
+    let n = a.frames.unwrap_or(300);
     match a.target {
-        Target::Attention => return crate::bench_attention::run(a.json, a.frames),
-        Target::Planning => return crate::bench_planning::run(a.json, a.frames.max(100)),
+        Target::Attention => return crate::bench_attention::run(a.json, n),
+        Target::Planning => return crate::bench_planning::run(a.json, n.max(100)),
         Target::Geometry => return crate::bench_geometry::run(a.json, 5),
         Target::Odometry => return crate::bench_odometry::run(a.json),
         Target::Logpolar => return crate::bench_logpolar::run(a.json),
         Target::Saliency => {}
     }
-    let backend: Backend = serde_json::from_value(json!(a.backend))
-        .with_context(|| format!("unknown backend '{}' (auto, scalar, avx2)", a.backend))?;
+    let backend_name = a.backend.as_deref().unwrap_or("auto");
+    let backend: Backend = serde_json::from_value(json!(backend_name))
+        .map_err(|_| anyhow::anyhow!("unknown backend '{backend_name}' (auto, scalar, avx2)"))?;
+    let (width, height) = a.size();
     let frames = frames(&a)?;
     let presets = if a.preset.is_empty() {
         SaliencyConfig::PRESETS.iter().map(|s| s.to_string()).collect()
@@ -194,45 +229,45 @@ pub fn run(a: BenchArgs) -> Result<()> {
         a.preset.clone()
     };
     let mut out = serde_json::Map::new();
-    out.insert("frame_width".into(), json!(a.width));
-    out.insert("frame_height".into(), json!(a.height));
+    out.insert("frame_width".into(), json!(width));
+    out.insert("frame_height".into(), json!(height));
     out.insert("threads".into(), json!(rayon::current_num_threads()));
     out.insert("backend".into(), json!(backend.name()));
     for p in &presets {
         let mut cfg = SaliencyConfig::preset(p)?;
         cfg.backend = backend;
-        out.insert(p.clone(), bench_preset(&cfg, &frames, a.frames)?);
+        out.insert(p.clone(), bench_preset(&cfg, &frames, n)?);
     }
     out.insert("peak_rss_mb".into(), json!(peak_rss_mb()));
     let v = serde_json::Value::Object(out);
     if a.json {
-        println!("{v}");
+        outln!("{v}");
         return Ok(());
     }
-    println!(
+    outln!(
         "saliency benchmark: {}x{}, backend {}, {} threads",
-        a.width,
-        a.height,
+        width,
+        height,
         backend.name(),
         rayon::current_num_threads()
     );
     for p in &presets {
         let r = &v[p];
-        println!(
+        outln!(
             "{p:>8}: {:.3} ms/frame on 1 thread (median of {}), {:.0} fps on all threads ({:.2}x)",
             r["ms_per_frame_1thread"].as_f64().unwrap_or(0.0),
-            a.frames,
+            n,
             r["fps_all_threads"].as_f64().unwrap_or(0.0),
             r["speedup_all_threads"].as_f64().unwrap_or(0.0)
         );
         if let Some(st) = r["stage_ms_1thread"].as_object() {
             for (k, ms) in st {
-                println!("          {k:<20} {:.3} ms", ms.as_f64().unwrap_or(0.0));
+                outln!("          {k:<20} {:.3} ms", ms.as_f64().unwrap_or(0.0));
             }
         }
     }
     if let Some(m) = v["peak_rss_mb"].as_f64() {
-        println!("peak resident memory: {m:.1} MiB");
+        outln!("peak resident memory: {m:.1} MiB");
     }
     Ok(())
 }

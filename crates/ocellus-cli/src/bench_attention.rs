@@ -149,25 +149,25 @@ pub fn run(json_out: bool, n: usize) -> Result<()> {
         "peak_rss_mb": peak_rss_mb(),
     });
     if json_out {
-        println!("{v}");
+        outln!("{v}");
         return Ok(());
     }
     let t = &v["temporal"];
     let f = |k: &str| t[k].as_f64().unwrap_or(f64::NAN);
-    println!("attention benchmark, 640x480, median over {n} frames on 1 thread (maps precomputed):");
-    println!(
+    outln!("attention benchmark, 640x480, median over {n} frames on 1 thread (maps precomputed):");
+    outln!(
         "  surprise + chaos + attention: {:.1} us/frame (surprise {:.1}, chaos {:.1}, attention {:.1})",
         f("us_per_frame_surprise_chaos_attention_1thread"),
         f("us_surprise"),
         f("us_chaos"),
         f("us_attention")
     );
-    println!("end to end over {SEQUENCE} frames (decode included):");
+    outln!("end to end over {SEQUENCE} frames (decode included):");
     for (k, val) in e2e {
-        println!("  {k:<32} {:.1} fps", val.as_f64().unwrap_or(f64::NAN));
+        outln!("  {k:<32} {:.1} fps", val.as_f64().unwrap_or(f64::NAN));
     }
     if let Some(m) = v["peak_rss_mb"].as_f64() {
-        println!("peak resident memory: {m:.1} MiB");
+        outln!("peak resident memory: {m:.1} MiB");
     }
     Ok(())
 }

@@ -99,11 +99,11 @@ pub fn run(json_out: bool, reps: usize) -> Result<()> {
         "ms_zhang_10_views_9x6": median(&mut t_zhang),
     });
     if json_out {
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!("geometry benchmark, one thread, medians:");
+        outln!("geometry benchmark, one thread, medians:");
         for (k, val) in v.as_object().into_iter().flatten() {
-            println!("  {k:<36} {:.4} ms", val.as_f64().unwrap_or(f64::NAN));
+            outln!("  {k:<36} {:.4} ms", val.as_f64().unwrap_or(f64::NAN));
         }
     }
     Ok(())

@@ -92,11 +92,11 @@ pub fn run(json_out: bool) -> Result<()> {
     figures.insert("ms_vergence_tracked_frame".into(), json!(median(&mut t)));
     let v = serde_json::Value::Object(figures);
     if json_out {
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!("log-polar benchmark, 640x480 -> 128 log rings (+ fovea) x 128 sectors, one thread, medians:");
+        outln!("log-polar benchmark, 640x480 -> 128 log rings (+ fovea) x 128 sectors, one thread, medians:");
         for (k, val) in v.as_object().into_iter().flatten() {
-            println!("  {k:<34} {:.4}", val.as_f64().unwrap_or(f64::NAN));
+            outln!("  {k:<34} {:.4}", val.as_f64().unwrap_or(f64::NAN));
         }
     }
     Ok(())

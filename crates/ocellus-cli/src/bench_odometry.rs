@@ -52,11 +52,11 @@ pub fn run(json_out: bool) -> Result<()> {
         "ms_sad_group_flows_1thread": median(&mut t_flow),
     });
     if json_out {
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!("odometry benchmark, 640x480, one thread, medians over {} frames x 3:", frames.len());
+        outln!("odometry benchmark, 640x480, one thread, medians over {} frames x 3:", frames.len());
         for (k, val) in v.as_object().into_iter().flatten() {
-            println!("  {k:<30} {:.4}", val.as_f64().unwrap_or(f64::NAN));
+            outln!("  {k:<30} {:.4}", val.as_f64().unwrap_or(f64::NAN));
         }
     }
     Ok(())

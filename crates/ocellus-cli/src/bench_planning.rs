@@ -45,9 +45,9 @@ pub fn run(json_out: bool, n: usize) -> Result<()> {
         "checksum_pan_deg": checksum,
     });
     if json_out {
-        println!("{v}");
+        outln!("{v}");
     } else {
-        println!(
+        outln!(
             "view planning: {:.1} us per decision (median of {n}, 19 candidates, 40x30 surprise map, 4 landmarks, 1 thread)",
             v["us_per_decision_1thread"].as_f64().unwrap_or(f64::NAN)
         );

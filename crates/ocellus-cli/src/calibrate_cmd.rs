@@ -78,7 +78,7 @@ fn run_dlt(a: DltArgs) -> Result<()> {
     });
     std::fs::write(&a.out, serde_json::to_string_pretty(&doc)?)
         .with_context(|| format!("cannot write {}", a.out.display()))?;
-    println!(
+    outln!(
         "{} points: fx {:.3} fy {:.3} cx {:.3} cy {:.3} skew {:.4} px; reprojection RMS {:.4} px; camera centre ({:.4}, {:.4}, {:.4})",
         p3.len(),
         cam.k.fx,
@@ -91,6 +91,6 @@ fn run_dlt(a: DltArgs) -> Result<()> {
         cam.centre().y,
         cam.centre().z
     );
-    println!("wrote {}", a.out.display());
+    outln!("wrote {}", a.out.display());
     Ok(())
 }

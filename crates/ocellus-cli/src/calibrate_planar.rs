@@ -47,10 +47,11 @@ pub struct ChessboardArgs {
     /// Images of the board (files or folders), at least 3 where the board is found, all of one size.
     #[arg(required = true)]
     images: Vec<PathBuf>,
-    /// Inner corners per row x per column (a board of 10x7 squares has 9x6).
+    /// Inner corners per row x per column (a board of 10x7 squares has 9x6). Range: 2..=64 each.
     #[arg(long, default_value = "9x6")]
     board: String,
-    /// Side of a square, with its unit: `25mm`, `2.5cm`, `0.025m` (a bare number is mm).
+    /// Side of a square, with its unit: `25mm`, `2.5cm`, `0.025m` (a bare number is mm). Range:
+    /// above 0, at most 1000 m.
     /// Poses in the report are in millimetres.
     #[arg(long, default_value = "25mm")]
     square: String,
@@ -66,7 +67,7 @@ pub struct ChessboardArgs {
 pub struct PlanarArgs {
     /// CSV of `view,X,Y,u,v`: view index, point on the target plane (target units), its pixel.
     points: PathBuf,
-    /// Image size `WxH` to record in the camera file.
+    /// Image size `WxH` to record in the camera file. Range: 1..=65536 each.
     #[arg(long)]
     image_size: Option<String>,
     #[command(flatten)]
@@ -77,15 +78,24 @@ pub struct PlanarArgs {
 }
 
 /// `9x6` -> (9, 6).
-pub fn parse_pair(s: &str, what: &str) -> Result<(usize, usize)> {
+pub fn parse_pair(s: &str, what: &str, range: std::ops::RangeInclusive<usize>) -> Result<(usize, usize)> {
     let parts: Vec<&str> = s.split(['x', 'X']).collect();
     let (Some(a), Some(b), 2) = (parts.first(), parts.get(1), parts.len()) else {
         bail!("{what} '{s}': expected two counts like 9x6");
     };
     let a: usize = a.trim().parse().with_context(|| format!("{what} '{s}'"))?;
     let b: usize = b.trim().parse().with_context(|| format!("{what} '{s}'"))?;
+    if !range.contains(&a) || !range.contains(&b) {
+        bail!("{what} '{s}': each count must be in the range {}..={}", range.start(), range.end());
+    }
     Ok((a, b))
 }
+
+/// Inner-corner counts of a chessboard a detector can find (per row and per column).
+pub const BOARD_RANGE: std::ops::RangeInclusive<usize> = 2..=64;
+
+/// Image sides a camera file may record, pixels.
+pub const IMAGE_SIDE_RANGE: std::ops::RangeInclusive<usize> = 1..=65_536;
 
 /// A length with unit (`mm`, `cm`, `m`; bare numbers are mm) in millimetres.
 pub fn parse_length_mm(s: &str) -> Result<f64> {
@@ -100,8 +110,8 @@ pub fn parse_length_mm(s: &str) -> Result<f64> {
         (t, 1.0)
     };
     let v: f64 = num.trim().parse().with_context(|| format!("length '{s}': expected e.g. 25mm"))?;
-    if !(v.is_finite() && v > 0.0) {
-        bail!("length '{s}' must be positive");
+    if !(v.is_finite() && v > 0.0 && v * scale <= 1e6) {
+        bail!("length '{s}' is outside the range: above 0, at most 1000 m");
     }
     Ok(v * scale)
 }
@@ -115,7 +125,7 @@ fn grey(img: &ocellus_image::convert::RgbImage) -> Plane<f32> {
 
 /// Runs `calibrate chessboard`.
 pub fn run_chessboard(a: ChessboardArgs) -> Result<()> {
-    let (cols, rows) = parse_pair(&a.board, "--board")?;
+    let (cols, rows) = parse_pair(&a.board, "--board", BOARD_RANGE)?;
     let square = parse_length_mm(&a.square)?;
     let files = collect_images(&a.images)?;
     std::fs::create_dir_all(a.out.join("corners")).with_context(|| format!("cannot create {}", a.out.display()))?;
@@ -150,12 +160,12 @@ pub fn run_chessboard(a: ChessboardArgs) -> Result<()> {
         }
         match found {
             Ok(corners) => {
-                println!("{}: {} corners", f.display(), corners.len());
+                outln!("{}: {} corners", f.display(), corners.len());
                 views.push(PlanarView { object: object.clone(), image: corners });
                 used.push(f.clone());
                 pictures.push(img);
             }
-            Err(e) => println!("{}: skipped ({e})", f.display()),
+            Err(e) => outln!("{}: skipped ({e})", f.display()),
         }
     }
     if views.len() < 3 {
@@ -178,7 +188,7 @@ pub fn run_chessboard(a: ChessboardArgs) -> Result<()> {
 /// Runs `calibrate planar`.
 pub fn run_planar(a: PlanarArgs) -> Result<()> {
     let rows = ocellus_io::csv::read_rows(&a.points, 5, "'view,X,Y,u,v'")?;
-    let size = a.image_size.as_deref().map(|s| parse_pair(s, "--image-size")).transpose()?;
+    let size = a.image_size.as_deref().map(|s| parse_pair(s, "--image-size", IMAGE_SIDE_RANGE)).transpose()?;
     let mut ids: Vec<i64> = Vec::new();
     let mut views: Vec<PlanarView> = Vec::new();
     for r in &rows {
@@ -262,15 +272,31 @@ fn report(
     )?;
     let k = &cal.intrinsics;
     let d = &cal.distortion;
-    println!("views {}, RMS reprojection error {:.4} px, {} iterations", names.len(), cal.rms_px, cal.iterations);
-    println!(
+    outln!("views {}, RMS reprojection error {:.4} px, {} iterations", names.len(), cal.rms_px, cal.iterations);
+    outln!(
         "fx {:.3} ± {:.3}  fy {:.3} ± {:.3}  cx {:.3} ± {:.3}  cy {:.3} ± {:.3} px",
-        k.fx, sd[0], k.fy, sd[1], k.cx, sd[2], k.cy, sd[3]
+        k.fx,
+        sd[0],
+        k.fy,
+        sd[1],
+        k.cx,
+        sd[2],
+        k.cy,
+        sd[3]
     );
-    println!(
+    outln!(
         "k1 {:.5} ± {:.5}  k2 {:.5} ± {:.5}  p1 {:.6} ± {:.6}  p2 {:.6} ± {:.6}  k3 {:.5} ± {:.5}",
-        d.k1, sd[4], d.k2, sd[5], d.p1, sd[6], d.p2, sd[7], d.k3, sd[8]
+        d.k1,
+        sd[4],
+        d.k2,
+        sd[5],
+        d.p1,
+        sd[6],
+        d.p2,
+        sd[7],
+        d.k3,
+        sd[8]
     );
-    println!("wrote {}/camera.toml, calibration.json, per_view_error.png", out.display());
+    outln!("wrote {}/camera.toml, calibration.json, per_view_error.png", out.display());
     Ok(())
 }

@@ -24,7 +24,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let src = dir.join("inputs");
     std::fs::create_dir_all(&src)?;
-    println!("ocellus demo: bottom-up saliency (Itti-Koch-Niebur) on {} built-in images", assets::IMAGES.len());
+    outln!("ocellus demo: bottom-up saliency (Itti-Koch-Niebur) on {} built-in images", assets::IMAGES.len());
     let mut peaks = Vec::new();
     for preset in SaliencyConfig::PRESETS {
         let cfg = SaliencyConfig::preset(preset)?;
@@ -39,7 +39,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
             if *preset == SaliencyConfig::PRESETS[0] {
                 peaks.push((path.clone(), r.peak_px));
             }
-            println!(
+            outln!(
                 "  {preset:>8} {:<10} map {}x{}, most salient at ({:.0}, {:.0}) px, {:.2} ms, {} files",
                 inputs::stem(&path),
                 r.map_size.0,
@@ -51,11 +51,11 @@ pub fn run(a: DemoArgs) -> Result<()> {
             );
         }
     }
-    println!("wrote maps, conspicuity maps and overlays to {}", dir.display());
+    outln!("wrote maps, conspicuity maps and overlays to {}", dir.display());
 
     // Foveal vision: each image seen through the log-polar retina fixating its most salient
     // point (where to look, then look there).
-    println!("ocellus demo: log-polar images fixating the most salient point of each image");
+    outln!("ocellus demo: log-polar images fixating the most salient point of each image");
     let fov = dir.join("logpolar");
     std::fs::create_dir_all(&fov)?;
     for (path, (px, py)) in &peaks {
@@ -68,17 +68,17 @@ pub fn run(a: DemoArgs) -> Result<()> {
         let stem = inputs::stem(path);
         let (c, i) = (fov.join(format!("{stem}.cortex.png")), fov.join(format!("{stem}.inverse.png")));
         logpolar_cmd::write_foveated(&map, &img, &c, &i)?;
-        println!(
+        outln!(
             "  {stem:<10} gaze ({px:.0}, {py:.0}) px: {} rows x {} sectors, compression {:.1}x",
             map.rows(),
             map.sectors(),
             map.compression_ratio()
         );
     }
-    println!("wrote cortical images and their inverses to {}", fov.display());
+    outln!("wrote cortical images and their inverses to {}", fov.display());
 
     // Attention over time: a generated sequence in which an object appears at frame 15.
-    println!("ocellus demo: surprise, context chaos and attention on a generated 30-frame sequence");
+    outln!("ocellus demo: surprise, context chaos and attention on a generated 30-frame sequence");
     let seq = dir.join("sequence");
     let cfg = SceneConfig::new(Scenario::SuddenObject);
     let event = cfg.event_frame;
@@ -94,7 +94,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
         limit: None,
     };
     let (n, saccades, written) = attend::run_quiet(args)?;
-    println!(
+    outln!(
         "  {n} frames, object appears at frame {event}; {saccades} saccades; wrote {} to {}",
         written.join(", "),
         dir.join("attend").display()

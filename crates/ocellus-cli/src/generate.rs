@@ -1,6 +1,7 @@
 //! `ocellus generate`: ground-truth sequences built from the built-in real images.
 
 use crate::assets;
+use crate::ranges;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use ocellus_image::convert::{to_image_rgb8, RgbImage};
@@ -44,20 +45,20 @@ struct AttentionArgs {
     /// Output folder: frames/frame_NNNNN.png (or sequence.y4m), truth.csv, pan_tilt.csv.
     #[arg(long, default_value = "ocellus-sequence")]
     out: PathBuf,
-    /// Number of frames.
-    #[arg(long, default_value_t = 30)]
+    /// Number of frames. Range: 2..=100000.
+    #[arg(long, default_value_t = 30, value_parser = ranges::within(2usize, 100_000))]
     frames: usize,
-    /// First frame showing the object (sudden).
-    #[arg(long, default_value_t = 15)]
+    /// First frame showing the object (sudden). Range: 1..=100000, and below --frames.
+    #[arg(long, default_value_t = 15, value_parser = ranges::within(1usize, 100_000))]
     event_frame: usize,
-    /// Seed of the sensor noise.
+    /// Seed of the sensor noise. Range: any 64-bit unsigned integer.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-    /// Sensor noise, standard deviation in grey levels.
-    #[arg(long, default_value_t = 2.0)]
+    /// Sensor noise, standard deviation in grey levels. Range: 0..=100.
+    #[arg(long, default_value_t = 2.0, value_parser = ranges::within(0.0f32, 100.0))]
     noise: f32,
-    /// Pan speed, pixels per frame (pan).
-    #[arg(long, default_value_t = 6.0)]
+    /// Pan speed, pixels per frame (pan). Range: -100..=100.
+    #[arg(long, default_value_t = 6.0, value_parser = ranges::within(-100.0f32, 100.0))]
     pan_px_per_frame: f32,
     /// Write one Y4M video instead of PNG frames.
     #[arg(long)]
@@ -141,7 +142,7 @@ pub fn write_sequence(cfg: SceneConfig, out: &Path, y4m: bool) -> Result<()> {
     }
     truth.flush()?;
     pan_tilt.flush()?;
-    println!(
+    outln!(
         "{} frames {}x{} ({:?}) written to {} ({}), with truth.csv and pan_tilt.csv",
         g.len(),
         c.width,

@@ -4,6 +4,7 @@
 use crate::assets;
 use crate::calibrate_planar::{parse_length_mm, parse_pair};
 use crate::camera_file::{self, CameraFile};
+use crate::ranges;
 use anyhow::{Context, Result};
 use clap::Args;
 use ocellus_geometry::camera::Intrinsics;
@@ -21,33 +22,34 @@ pub struct ChessboardArgs {
     /// input format of `ocellus calibrate planar`).
     #[arg(long, default_value = "ocellus-chessboard")]
     out: PathBuf,
-    /// Number of views.
-    #[arg(long, default_value_t = 12)]
+    /// Number of views. Range: 1..=1000.
+    #[arg(long, default_value_t = 12, value_parser = ranges::within(1usize, 1000))]
     views: usize,
-    /// Inner corners per row x per column.
+    /// Inner corners per row x per column. Range: 2..=64 each.
     #[arg(long, default_value = "9x6")]
     board: String,
     /// Square side with unit (`25mm`, `2.5cm`); board coordinates in the CSV are millimetres.
+    /// Range: above 0, at most 1000 m.
     #[arg(long, default_value = "25mm")]
     square: String,
     /// Camera to render through (camera file); default: 640x480, fx 640, fy 636, k1 -0.22,
     /// k2 0.06, p1 0.0008, p2 -0.0005.
     #[arg(long)]
     camera: Option<PathBuf>,
-    /// Largest board tilt, degrees.
-    #[arg(long, default_value_t = 40.0)]
+    /// Largest board tilt, degrees. Range: 0..=70.
+    #[arg(long, default_value_t = 40.0, value_parser = ranges::within(0.0f64, 70.0))]
     max_tilt_deg: f64,
-    /// Sensor noise, standard deviation in grey levels.
-    #[arg(long, default_value_t = 2.0)]
+    /// Sensor noise, standard deviation in grey levels. Range: 0..=100.
+    #[arg(long, default_value_t = 2.0, value_parser = ranges::within(0.0f32, 100.0))]
     noise: f32,
-    /// Seed of the poses and the noise.
+    /// Seed of the poses and the noise. Range: any 64-bit unsigned integer.
     #[arg(long, default_value_t = 1)]
     seed: u64,
 }
 
 /// Runs the subcommand.
 pub fn run(a: ChessboardArgs) -> Result<()> {
-    let (cols, rows) = parse_pair(&a.board, "--board")?;
+    let (cols, rows) = parse_pair(&a.board, "--board", crate::calibrate_planar::BOARD_RANGE)?;
     let board = Board::new(cols, rows, parse_length_mm(&a.square)?)?;
     let truth = match &a.camera {
         Some(p) => camera_file::read(p)?,
@@ -86,7 +88,7 @@ pub fn run(a: ChessboardArgs) -> Result<()> {
         }
     }
     csv.flush()?;
-    println!(
+    outln!(
         "{} views of a {cols}x{rows} board written to {} (view_NN.png, camera_truth.toml, corners_truth.csv)",
         a.views,
         a.out.display()

@@ -2,6 +2,7 @@
 //! floor of real textures with known planar motion, for visual odometry.
 
 use crate::assets;
+use crate::ranges;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use ocellus_image::convert::RgbImage;
@@ -31,14 +32,14 @@ pub struct GroundArgs {
     /// Floor texture.
     #[arg(long, value_enum, default_value = "mosaic")]
     texture: TextureArg,
-    /// Seed of the tiles, the motion and the noise.
+    /// Seed of the tiles, the motion and the noise. Range: any 64-bit unsigned integer.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// The hard variant: noise sigma 5, motion blur, +-5 % gain flicker, +-1 % height oscillation.
     #[arg(long)]
     hard: bool,
-    /// Number of frames (200 Hz).
-    #[arg(long, default_value_t = 200)]
+    /// Number of frames (200 Hz). Range: 2..=100000.
+    #[arg(long, default_value_t = 200, value_parser = ranges::within(2usize, 100_000))]
     frames: usize,
     /// Write one Y4M video instead of PNG frames.
     #[arg(long)]
@@ -119,7 +120,7 @@ pub fn run(a: GroundArgs) -> Result<()> {
         (cfg.height as f64 - 1.0) / 2.0
     )?;
     cam.flush()?;
-    println!(
+    outln!(
         "{} frames {}x{} ({:?}{}) written to {} with groundtruth.tum, encoders.csv, camera.toml",
         scene.len(),
         cfg.width,

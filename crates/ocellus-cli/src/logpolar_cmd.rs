@@ -3,13 +3,14 @@
 //! disparity at a gaze point of a stereo pair.
 
 use crate::frames::for_each_frame;
-use crate::video_out::VideoWriter;
+use crate::ranges;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use ocellus_fovea::logpolar::{Fields, LogPolarConfig, LogPolarMap, Scratch};
 use ocellus_fovea::register::{register, Mode, RegisterOptions};
 use ocellus_fovea::vergence::{vergence, VergenceOptions};
 use ocellus_image::Plane;
+use ocellus_io::video_writer::VideoWriter;
 use std::path::{Path, PathBuf};
 
 /// Arguments of `ocellus logpolar`.
@@ -22,20 +23,21 @@ pub struct LogPolarArgs {
     /// video (every frame through the same map).
     #[arg(required = true)]
     image: Option<PathBuf>,
-    /// Log rings between the fovea radius and the outer radius.
-    #[arg(long, default_value_t = 128)]
+    /// Log rings between the fovea radius and the outer radius. Range: 1..=4096.
+    #[arg(long, default_value_t = 128, value_parser = ranges::within(1usize, 4096))]
     rings: usize,
-    /// Sectors over the full turn.
-    #[arg(long, default_value_t = 128)]
+    /// Sectors over the full turn. Range: 4..=4096.
+    #[arg(long, default_value_t = 128, value_parser = ranges::within(4usize, 4096))]
     sectors: usize,
     /// Gaze point `X,Y` in pixels (pixel centres at integers) [default: the image centre].
     #[arg(long, value_parser = parse_point)]
     fovea: Option<[f64; 2]>,
-    /// Fovea radius rho_0, pixels [default: outer radius / 60, at least 2].
-    #[arg(long)]
+    /// Fovea radius rho_0, pixels [default: outer radius / 60, at least 2]. Range: 0.5..=100000,
+    /// and below the outer radius.
+    #[arg(long, value_parser = ranges::within(0.5f64, 1e5))]
     fovea_radius: Option<f64>,
-    /// Outer radius rho_max, pixels [default: half the image's smaller side].
-    #[arg(long)]
+    /// Outer radius rho_max, pixels [default: half the image's smaller side]. Range: 2..=100000.
+    #[arg(long, value_parser = ranges::within(2.0f64, 1e5))]
     max_radius: Option<f64>,
     /// Receptive fields: `pyramid` (fast, one bilinear read of the box-pyramid level as large
     /// as the cell) or `area` (the exact mean over each cell's annular sector).
@@ -95,11 +97,11 @@ struct VergenceArgs {
     /// Gaze point `X,Y` in the left image, pixels.
     #[arg(long, value_parser = parse_point)]
     gaze: [f64; 2],
-    /// Largest disparity searched, pixels.
-    #[arg(long, default_value_t = 64)]
+    /// Largest disparity searched, pixels. Range: 1..=1024.
+    #[arg(long, default_value_t = 64, value_parser = ranges::within(1i64, 1024))]
     max_disparity: i64,
-    /// Outer radius of the compared field, pixels.
-    #[arg(long, default_value_t = 24.0)]
+    /// Outer radius of the compared field, pixels. Range: 4..=1000.
+    #[arg(long, default_value_t = 24.0, value_parser = ranges::within(4.0f64, 1000.0))]
     radius: f64,
     /// Print one JSON object instead of text.
     #[arg(long)]
@@ -157,7 +159,7 @@ pub fn run(a: LogPolarArgs) -> Result<()> {
         "rgb_sample_and_write_us": sample_us,
     });
     std::fs::write(a.out.join("logpolar.json"), serde_json::to_string_pretty(&info)?)?;
-    println!(
+    outln!(
         "{w}x{h} -> {} rows ({} fovea + {} log rings, ratio {:.5}) x {} sectors: compression {:.1}x; wrote cortex.png, inverse.png, logpolar.json in {}",
         map.rows(),
         cfg.fovea_rings,
@@ -257,7 +259,7 @@ fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
         "median_rgb_sample_us": median_us,
     });
     std::fs::write(a.out.join("logpolar.json"), serde_json::to_string_pretty(&info)?)?;
-    println!(
+    outln!(
         "{n} frames -> {} rows x {} sectors, {median_us:.0} us per frame (median, sampling only); wrote cortex/NNNNN.png{}, logpolar.json in {}",
         map.rows(),
         map.sectors(),
@@ -284,13 +286,13 @@ fn run_register(r: &RegisterArgs) -> Result<()> {
     };
     let est = register(&a, &b, &RegisterOptions { mode, ..Default::default() })?;
     if r.json {
-        println!("{}", serde_json::to_string(&est)?);
+        outln!("{}", serde_json::to_string(&est)?);
     } else {
-        println!("rotation {:.3} deg, scale {:.5}", est.angle_deg, est.scale);
+        outln!("rotation {:.3} deg, scale {:.5}", est.angle_deg, est.scale);
         if mode == Mode::Spectrum {
-            println!("translation {:.2}, {:.2} px", est.translation[0], est.translation[1]);
+            outln!("translation {:.2}, {:.2} px", est.translation[0], est.translation[1]);
         }
-        println!("peak {:.3}", est.peak);
+        outln!("peak {:.3}", est.peak);
     }
     Ok(())
 }
@@ -301,9 +303,9 @@ fn run_vergence(v: &VergenceArgs) -> Result<()> {
     let opts = VergenceOptions { max_disparity: v.max_disparity, max_radius: v.radius, ..Default::default() };
     let est = vergence(&l, &r, v.gaze, &opts)?;
     if v.json {
-        println!("{}", serde_json::to_string(&est)?);
+        outln!("{}", serde_json::to_string(&est)?);
     } else {
-        println!("disparity {:.2} px (correlation {:.3})", est.disparity_px, est.score);
+        outln!("disparity {:.2} px (correlation {:.3})", est.disparity_px, est.score);
     }
     Ok(())
 }

@@ -1,5 +1,8 @@
 //! `ocellus`: the command-line program of the ocellus active-vision toolkit.
 
+#[macro_use]
+mod out;
+
 mod assets;
 mod attend;
 mod bench;
@@ -25,15 +28,15 @@ mod odometry_cmd;
 mod overlay;
 mod plan_cmd;
 mod plot;
+mod ranges;
 mod saliency_cmd;
 mod stereo_cmd;
 mod surprise_cmd;
 mod triangulate_cmd;
 mod undistort_cmd;
-mod video_out;
 
 use anyhow::Result;
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// Fast, biologically inspired active vision: where to look, how it moved, where things are.
 #[derive(Parser, Debug)]
@@ -94,15 +97,22 @@ enum Command {
     Bench(bench::BenchArgs),
 }
 
-fn main() {
-    // Behave like other command-line programs when the reader of stdout goes away
-    // (`ocellus ... | head`): end quietly instead of panicking on the write.
-    #[cfg(unix)]
-    // SAFETY: restoring the default action of SIGPIPE before any thread is started.
-    unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+/// The command tree, with negative numbers read as values everywhere (`--blur -1` reaches the
+/// range check in `ranges` instead of being taken for an unknown flag).
+fn command() -> clap::Command {
+    fn negative_numbers(c: clap::Command) -> clap::Command {
+        c.allow_negative_numbers(true).mut_subcommands(negative_numbers)
     }
-    let cli = Cli::parse();
+    negative_numbers(Cli::command())
+}
+
+fn main() {
+    // SIGPIPE stays ignored (Rust's default): a closed stdout or a dead ffmpeg then shows up
+    // as a write error that is reported (see `out`), not as a silent death by signal.
+    let cli = match Cli::from_arg_matches(&command().get_matches()) {
+        Ok(c) => c,
+        Err(e) => e.exit(),
+    };
     let r: Result<()> = match cli.command {
         Command::Demo(a) => demo::run(a),
         Command::Saliency(a) => saliency_cmd::run(a),
@@ -119,8 +129,67 @@ fn main() {
         Command::Odometry(a) => odometry_cmd::run(a),
         Command::Logpolar(a) => logpolar_cmd::run(a),
     };
+    let r = r.and_then(|()| Ok(out::flush_stdout()?));
     if let Err(e) = r {
-        eprintln!("error: {e:#}");
+        let stdout = e.chain().find_map(|c| c.downcast_ref::<out::StdoutError>());
+        if stdout.is_some_and(out::StdoutError::is_broken_pipe) {
+            // The reader took what it wanted (`| head -1`): end quietly, with the status a
+            // shell gives a program stopped by SIGPIPE.
+            std::process::exit(141);
+        }
+        errln!("error: {e:#}");
         std::process::exit(1);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every numeric option states its range in `--help`, so the one check in `ranges` and
+    /// what the user reads cannot drift apart unnoticed.
+    #[test]
+    fn every_numeric_option_states_its_range() {
+        use clap::builder::ValueParser;
+        let numeric = [
+            ValueParser::from(clap::value_parser!(f64)).type_id(),
+            ValueParser::from(clap::value_parser!(f32)).type_id(),
+            ValueParser::from(clap::value_parser!(u8)).type_id(),
+            ValueParser::from(clap::value_parser!(u16)).type_id(),
+            ValueParser::from(clap::value_parser!(u32)).type_id(),
+            ValueParser::from(clap::value_parser!(u64)).type_id(),
+            ValueParser::from(clap::value_parser!(usize)).type_id(),
+            ValueParser::from(clap::value_parser!(i64)).type_id(),
+        ];
+        fn walk<T: PartialEq>(
+            c: &clap::Command,
+            path: &str,
+            numeric: &[T],
+            id: &dyn Fn(&clap::Arg) -> T,
+            missing: &mut Vec<String>,
+        ) {
+            for a in c.get_arguments() {
+                let help = a.get_long_help().or(a.get_help()).map(|h| h.to_string()).unwrap_or_default();
+                if numeric.contains(&id(a)) && !help.contains("Range") {
+                    missing.push(format!("{path} --{}", a.get_id()));
+                }
+            }
+            for s in c.get_subcommands() {
+                walk(s, &format!("{path} {}", s.get_name()), numeric, id, missing);
+            }
+        }
+        let mut missing = Vec::new();
+        walk(&command(), "ocellus", &numeric, &|a| a.get_value_parser().type_id(), &mut missing);
+        assert!(missing.is_empty(), "numeric options without a stated range: {missing:?}");
+        // The walk does see numeric options.
+        let bench = command()
+            .find_subcommand("bench")
+            .and_then(|b| b.get_arguments().find(|a| a.get_id() == "frames").cloned());
+        assert!(bench.is_some_and(|a| numeric.contains(&a.get_value_parser().type_id())));
+    }
+
+    #[test]
+    fn command_tree_is_consistent() {
+        command().debug_assert();
     }
 }

@@ -4,6 +4,7 @@
 use crate::camera_file;
 use crate::frames::for_each_frame;
 use crate::plot::{self, Plot, Series};
+use crate::ranges;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use ocellus_geometry::distortion::{remap_bilinear, undistort_maps};
@@ -28,28 +29,31 @@ pub struct OdometryArgs {
     /// `height_m`, `mount_right_m`, `mount_forward_m` unless given below.
     #[arg(long, required = true)]
     camera: Option<PathBuf>,
-    /// Camera height above the floor, metres (overrides the camera file).
-    #[arg(long)]
+    /// Camera height above the floor, metres (overrides the camera file). Range: above 0, at
+    /// most 1000.
+    #[arg(long, value_parser = ranges::above(0.0f64, 1000.0))]
     height_m: Option<f64>,
     /// Camera position ahead of the rotation centre, metres (overrides the camera file).
-    #[arg(long)]
+    /// Range: -100..=100.
+    #[arg(long, value_parser = ranges::within(-100.0f64, 100.0))]
     mount_forward_m: Option<f64>,
     /// Camera position right of the rotation centre, metres (overrides the camera file).
-    #[arg(long)]
+    /// Range: -100..=100.
+    #[arg(long, value_parser = ranges::within(-100.0f64, 100.0))]
     mount_right_m: Option<f64>,
     /// Estimator: `robust` (sub-pixel flow with per-window uncertainty, a robust fit over all
     /// windows) or `seed` (the seed's integer SAD groups and filter).
     #[arg(long, value_enum, default_value = "robust")]
     mode: Mode,
-    /// Frame rate, Hz (timestamps of the trajectory).
-    #[arg(long, default_value_t = 200.0)]
+    /// Frame rate, Hz (timestamps of the trajectory). Range: above 0, at most 1000000.
+    #[arg(long, default_value_t = 200.0, value_parser = ranges::above(0.0f64, 1e6))]
     rate_hz: f64,
     /// Wheel encoders to fuse: CSV `time_s,forward_m,yaw_rad` (a header allowed), one reading
     /// per interval ending at time_s (e.g. `encoders.csv` of `synth ground`).
     #[arg(long)]
     encoders: Option<PathBuf>,
-    /// Encoder rate, Hz.
-    #[arg(long, default_value_t = 30.0)]
+    /// Encoder rate, Hz. Range: above 0, at most 1000000.
+    #[arg(long, default_value_t = 30.0, value_parser = ranges::above(0.0f64, 1e6))]
     encoder_rate_hz: f64,
     /// Output folder: trajectory.tum (fused with the encoders when given; then also
     /// trajectory_vision.tum), trajectory.png, flow_NNNNN.png for a few frames.
@@ -80,8 +84,8 @@ struct EvalArgs {
     estimate: PathBuf,
     /// Ground truth (TUM).
     truth: PathBuf,
-    /// Largest timestamp difference when pairing poses, seconds.
-    #[arg(long, default_value_t = 0.001)]
+    /// Largest timestamp difference when pairing poses, seconds. Range: above 0, at most 10.
+    #[arg(long, default_value_t = 0.001, value_parser = ranges::above(0.0f64, 10.0))]
     max_dt: f64,
     /// Plot of both trajectories.
     #[arg(long, default_value = "trajectories.png")]
@@ -166,22 +170,23 @@ pub fn run(a: OdometryArgs) -> Result<()> {
             &a.out.join("trajectory.png"),
             &[("fused", &poses, RGBColor(200, 40, 40)), ("vision", &vision_poses, RGBColor(40, 90, 200))],
         )?;
-        println!(
+        outln!(
             "encoders: {} frames with slipping wheels ignored, {} bridged by the wheels",
-            fusion.rejected, fusion.bridged
+            fusion.rejected,
+            fusion.bridged
         );
     } else {
         plot_trajectories(&a.out.join("trajectory.png"), &[("estimate", &poses, RGBColor(200, 40, 40))])?;
     }
     let last = poses.last().context("no frames")?;
-    println!(
+    outln!(
         "{n} frames in {secs:.2} s ({:.0} fps, decoding included); {failures} without texture; final pose ({:.4}, {:.4}) m, {:.2} deg",
         n as f64 / secs.max(1e-9),
         last.position[0],
         last.position[1],
         last.yaw().to_degrees()
     );
-    println!("wrote trajectory.tum, trajectory.png and flow overlays in {}", a.out.display());
+    outln!("wrote trajectory.tum, trajectory.png and flow overlays in {}", a.out.display());
     Ok(())
 }
 
@@ -278,11 +283,11 @@ fn eval(a: &EvalArgs) -> Result<()> {
         })
         .collect();
     let rpe_rmse = (rpe.iter().map(|v| v * v).sum::<f64>() / rpe.len() as f64).sqrt();
-    println!("{} poses paired, path {:.4} m", pairs.len(), path);
-    println!("final drift {drift:.4} % of the path, final heading error {heading:.4} deg");
-    println!("ATE RMSE {:.3} mm, RPE per frame RMSE {:.4} mm", ate * 1e3, rpe_rmse * 1e3);
+    outln!("{} poses paired, path {:.4} m", pairs.len(), path);
+    outln!("final drift {drift:.4} % of the path, final heading error {heading:.4} deg");
+    outln!("ATE RMSE {:.3} mm, RPE per frame RMSE {:.4} mm", ate * 1e3, rpe_rmse * 1e3);
     let (e, g): (Vec<TumPose>, Vec<TumPose>) = pairs.into_iter().unzip();
     plot_trajectories(&a.plot, &[("ground truth", &g, RGBColor(30, 30, 30)), ("estimate", &e, RGBColor(200, 40, 40))])?;
-    println!("wrote {}", a.plot.display());
+    outln!("wrote {}", a.plot.display());
     Ok(())
 }

@@ -31,10 +31,10 @@ struct CorridorArgs {
     /// A person appears suddenly at step 5 (the bottom-up case).
     #[arg(long)]
     event: bool,
-    /// Number of planning steps.
-    #[arg(long, default_value_t = 16)]
+    /// Number of planning steps. Range: 1..=10000.
+    #[arg(long, default_value_t = 16, value_parser = crate::ranges::within(1usize, 10_000))]
     steps: usize,
-    /// Seed of odometry, bearing and sensor noise.
+    /// Seed of odometry, bearing and sensor noise. Range: any 64-bit unsigned integer.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Output folder.
@@ -166,17 +166,24 @@ pub fn run(a: PlanArgs) -> Result<()> {
             },
         )?;
     }
-    println!("step  x(m)  chaos(bits)  v  pan -> chosen (deg)  landmarks  cov trace (m^2)");
+    outln!("step  x(m)  chaos(bits)  v  pan -> chosen (deg)  landmarks  cov trace (m^2)");
     for r in &records {
-        println!(
+        outln!(
             "{:>4} {:>5.1} {:>12.3} {:>2} {:>5} -> {:>6} {:>10} {:>16.5}",
-            r.step, r.true_xy.0, r.chaos, r.decision.v, r.pan_deg, r.decision.pan_deg, r.observed, r.cov_trace
+            r.step,
+            r.true_xy.0,
+            r.chaos,
+            r.decision.v,
+            r.pan_deg,
+            r.decision.pan_deg,
+            r.observed,
+            r.cov_trace
         );
     }
     if let Some(b) = &baseline {
         let v: Vec<String> = b.iter().map(|r| format!("{}", r.decision.pan_deg)).collect();
-        println!("without the event, chosen pans: {}", v.join(" "));
+        outln!("without the event, chosen pans: {}", v.join(" "));
     }
-    println!("wrote frames/, steps.csv, angles.png, gains_step{k}.png in {}", a.out.display());
+    outln!("wrote frames/, steps.csv, angles.png, gains_step{k}.png in {}", a.out.display());
     Ok(())
 }

@@ -102,7 +102,7 @@ pub fn process_one(
 pub fn run(a: SaliencyArgs) -> Result<()> {
     let cfg = config_file::load(&a.preset, a.config.as_deref())?;
     if a.print_config {
-        print!("{}", config_file::to_toml(&cfg)?);
+        out!("{}", config_file::to_toml(&cfg)?);
         return Ok(());
     }
     let files = inputs::collect_images(&a.images)?;
@@ -122,8 +122,8 @@ pub fn run(a: SaliencyArgs) -> Result<()> {
         bar.set_message(inputs::stem(f));
         match process_one(f, &cfg, &mut engine, &a.out, a.conspicuity) {
             Ok(r) => {
-                bar.suspend(|| {
-                    println!(
+                bar.suspend(|| -> Result<()> {
+                    outln!(
                         "{}: map {}x{}, most salient at ({:.0}, {:.0}) px",
                         f.display(),
                         r.map_size.0,
@@ -136,20 +136,21 @@ pub fn run(a: SaliencyArgs) -> Result<()> {
                             let t = e.timings();
                             let parts: Vec<String> =
                                 t.stages().iter().map(|(n, d)| format!("{n} {:.3}", d.as_secs_f64() * 1e3)).collect();
-                            println!("  timings ms: {}; total {:.3}", parts.join(", "), t.total().as_secs_f64() * 1e3);
+                            outln!("  timings ms: {}; total {:.3}", parts.join(", "), t.total().as_secs_f64() * 1e3);
                         }
                     }
-                });
+                    Ok(())
+                })?;
             }
             Err(e) => {
                 failed += 1;
-                bar.suspend(|| eprintln!("error: {e:#}"));
+                bar.suspend(|| errln!("error: {e:#}"));
             }
         }
         bar.inc(1);
     }
     bar.finish_and_clear();
-    println!("wrote maps to {}", a.out.display());
+    outln!("wrote maps to {}", a.out.display());
     if failed > 0 {
         bail!("{failed} of {} images failed", files.len());
     }

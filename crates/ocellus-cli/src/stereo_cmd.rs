@@ -23,21 +23,22 @@ pub struct StereoArgs {
     /// semi-global matching (census costs, 8 paths by default).
     #[arg(long, value_enum, default_value = "sgm")]
     pub method: Method,
-    /// Disparities searched: 0..N pixels.
-    #[arg(long, default_value_t = 64)]
+    /// Disparities searched: 0..N pixels. Range: 1..=1024.
+    #[arg(long, default_value_t = 64, value_parser = crate::ranges::within(1usize, 1024))]
     pub max_disp: usize,
-    /// Odd block size of `bm`, pixels.
-    #[arg(long, default_value_t = 9)]
+    /// Odd block size of `bm`, pixels. Range: odd, 3..=63.
+    #[arg(long, default_value_t = 9, value_parser = crate::ranges::within(3usize, 63))]
     pub block: usize,
     /// Uniqueness margin (default 0.15 for bm, 0.05 for sgm: the best cost must beat every
-    /// non-adjacent disparity by this fraction).
-    #[arg(long)]
+    /// non-adjacent disparity by this fraction). Range: 0..=0.99.
+    #[arg(long, value_parser = crate::ranges::within(0.0f32, 0.99))]
     pub uniqueness: Option<f32>,
-    /// Paths of `sgm`: 8 or 4.
-    #[arg(long, default_value_t = 8)]
+    /// Paths of `sgm`. Range: 4 or 8.
+    #[arg(long, default_value_t = 8, value_parser = crate::ranges::within(4u8, 8))]
     pub paths: u8,
-    /// Penalties P1 and P2 of `sgm` (census bits).
-    #[arg(long, num_args = 2, value_names = ["P1", "P2"], default_values_t = [10u16, 120])]
+    /// Penalties P1 and P2 of `sgm` (census bits). Range: 0..=1000 each, P1 <= P2.
+    #[arg(long, num_args = 2, value_names = ["P1", "P2"], default_values_t = [10u16, 120],
+          value_parser = crate::ranges::within(0u16, 1000))]
     pub penalties: Vec<u16>,
     /// 3x3 median of the `sgm` disparities.
     #[arg(long)]
@@ -45,14 +46,16 @@ pub struct StereoArgs {
     /// Ground-truth disparity (PFM, inf where unknown): prints bad-2.0 and density.
     #[arg(long)]
     pub truth: Option<PathBuf>,
-    /// Focal length in pixels (with --baseline: depth map and point cloud).
-    #[arg(long)]
+    /// Focal length in pixels (with --baseline: depth map and point cloud). Range: above 0,
+    /// at most 1000000.
+    #[arg(long, value_parser = crate::ranges::above(0.0f64, 1e6))]
     pub focal_px: Option<f64>,
-    /// Baseline, in the unit wanted for depths (e.g. mm).
-    #[arg(long)]
+    /// Baseline, in the unit wanted for depths (e.g. mm). Range: above 0, at most 1e9.
+    #[arg(long, value_parser = crate::ranges::above(0.0f64, 1e9))]
     pub baseline: Option<f64>,
-    /// Principal point x offset between the cameras (Middlebury doffs), pixels.
-    #[arg(long, default_value_t = 0.0)]
+    /// Principal point x offset between the cameras (Middlebury doffs), pixels. Range:
+    /// -100000..=100000.
+    #[arg(long, default_value_t = 0.0, value_parser = crate::ranges::within(-1e5f64, 1e5))]
     pub doffs: f64,
     /// Output folder: disparity.png, disparity.pfm, and depth.pfm, points.ply with calibration.
     #[arg(long, default_value = "ocellus-stereo")]
@@ -154,7 +157,7 @@ pub fn run(a: StereoArgs) -> Result<()> {
     ocellus_io::write_png(a.out.join("disparity.png"), &to_image_rgb8(&disparity_image(&disp, a.max_disp as f32)))?;
     ocellus_io::pfm::write(a.out.join("disparity.pfm"), &disp)?;
     let valid = disp.to_vec().iter().filter(|v| v.is_finite()).count();
-    println!(
+    outln!(
         "{what} {}x{}, {} disparities: {ms:.1} ms (first run, buffers included), {:.1} % of pixels with a disparity",
         l.width(),
         l.height(),
@@ -165,19 +168,19 @@ pub fn run(a: StereoArgs) -> Result<()> {
     if let Some(tp) = &a.truth {
         let truth = ocellus_io::pfm::read(tp)?;
         let (bad, density) = bad_pixels(&disp, &truth, 2.0)?;
-        println!("against {}: bad-2.0 {:.2} %, density {:.2} %", tp.display(), bad * 100.0, density * 100.0);
+        outln!("against {}: bad-2.0 {:.2} %, density {:.2} %", tp.display(), bad * 100.0, density * 100.0);
     }
     match (a.focal_px, a.baseline) {
         (Some(f), Some(b)) => {
             let rig = ParallelStereo { baseline: b, focal_px: f };
             let (n, depth) = write_cloud(&a.out.join("points.ply"), &disp, &li, &rig, a.doffs)?;
             ocellus_io::pfm::write(a.out.join("depth.pfm"), &depth)?;
-            println!("{n} points (units of the baseline, left camera frame)");
+            outln!("{n} points (units of the baseline, left camera frame)");
             written.extend(["depth.pfm", "points.ply"]);
         }
         (None, None) => {}
         _ => bail!("--focal-px and --baseline go together"),
     }
-    println!("wrote {} in {}", written.join(", "), a.out.display());
+    outln!("wrote {} in {}", written.join(", "), a.out.display());
     Ok(())
 }

@@ -22,8 +22,8 @@ pub struct SurpriseArgs {
     /// Also write each surprise map (bits, map level) as NumPy .npy.
     #[arg(long)]
     pub npy: bool,
-    /// Process at most N frames.
-    #[arg(long)]
+    /// Process at most N frames. Range: 1..=10000000.
+    #[arg(long, value_parser = crate::ranges::within(1usize, 10_000_000))]
     pub limit: Option<usize>,
 }
 
@@ -72,7 +72,7 @@ pub fn run(a: SurpriseArgs) -> Result<()> {
     });
     csv.flush()?;
     let n = result?;
-    println!(
+    outln!(
         "{n} frames; largest surprise {:.2} bits at frame {}; wrote surprise/ and surprise.csv in {}",
         peak.0,
         peak.1,

@@ -85,6 +85,6 @@ pub fn run(a: TriangulateArgs) -> Result<()> {
         behind += usize::from(!t.in_front);
     }
     out.flush()?;
-    println!("{n} points triangulated from {} cameras ({behind} behind a camera); wrote {}", ps.len(), a.out.display());
+    outln!("{n} points triangulated from {} cameras ({behind} behind a camera); wrote {}", ps.len(), a.out.display());
     Ok(())
 }

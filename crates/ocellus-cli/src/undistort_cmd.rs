@@ -58,6 +58,6 @@ pub fn run(a: UndistortArgs) -> Result<()> {
         let path = a.out.join(format!("{}.png", stem(f)));
         ocellus_io::write_png(&path, &out)?;
     }
-    println!("{} images undistorted into {}", files.len(), a.out.display());
+    outln!("{} images undistorted into {}", files.len(), a.out.display());
     Ok(())
 }

@@ -7,7 +7,7 @@
 //! - [`csv`]: numeric CSV rows; [`points`]: CSV files of 2D points (fixations), in pixels.
 //! - [`ply`]: coloured point clouds.
 //! - [`video`]: frame sources (image folders, Y4M, any video through the ffmpeg program) and
-//!   [`y4m`] reading and writing.
+//!   [`y4m`] reading and writing; [`video_writer`]: MP4 output through ffmpeg.
 //!
 //! ```
 //! use ocellus_image::Plane;
@@ -27,6 +27,7 @@ pub mod ply;
 pub mod points;
 pub mod tum;
 pub mod video;
+pub mod video_writer;
 pub mod y4m;
 
 use ocellus_image::convert::{from_dynamic, RgbImage};

@@ -59,7 +59,27 @@ pub fn list_images(dir: &Path) -> Result<Vec<PathBuf>> {
 
 /// The last bytes ffmpeg wrote to stderr (its error messages), drained by a thread so that a
 /// chatty ffmpeg can never block on a full pipe.
-type StderrTail = Arc<Mutex<Vec<u8>>>;
+pub(crate) type StderrTail = Arc<Mutex<Vec<u8>>>;
+
+/// Starts the thread that keeps the last 8 KiB of `err`; it ends when the process closes it.
+pub(crate) fn drain_stderr(mut err: impl Read + Send + 'static) -> (StderrTail, std::thread::JoinHandle<()>) {
+    let tail: StderrTail = Arc::default();
+    let sink = Arc::clone(&tail);
+    let handle = std::thread::spawn(move || {
+        let mut chunk = [0u8; 4096];
+        while let Ok(n) = err.read(&mut chunk) {
+            if n == 0 {
+                break;
+            }
+            if let Ok(mut t) = sink.lock() {
+                t.extend_from_slice(&chunk[..n]);
+                let excess = t.len().saturating_sub(8192);
+                t.drain(..excess);
+            }
+        }
+    });
+    (tail, handle)
+}
 
 /// A running ffmpeg decoder.
 #[derive(Debug)]
@@ -142,24 +162,10 @@ impl Ffmpeg {
             .stderr(Stdio::piped())
             .spawn()
             .map_err(|e| ffmpeg_missing("ffmpeg", e))?;
-        let (Some(stdout), Some(mut err)) = (child.stdout.take(), child.stderr.take()) else {
+        let (Some(stdout), Some(err)) = (child.stdout.take(), child.stderr.take()) else {
             return Err(IoError::Ffmpeg("ffmpeg started without pipes".into()));
         };
-        let stderr: StderrTail = Arc::default();
-        let sink = Arc::clone(&stderr);
-        let drain = std::thread::spawn(move || {
-            let mut chunk = [0u8; 4096];
-            while let Ok(n) = err.read(&mut chunk) {
-                if n == 0 {
-                    break;
-                }
-                if let Ok(mut tail) = sink.lock() {
-                    tail.extend_from_slice(&chunk[..n]);
-                    let excess = tail.len().saturating_sub(8192);
-                    tail.drain(..excess);
-                }
-            }
-        });
+        let (stderr, drain) = drain_stderr(err);
         let buf = vec![0u8; width * height * 3];
         Ok(Self {
             child,

@@ -22,7 +22,7 @@ use serde_json::json;
 use std::path::PathBuf;
 
 /// Blur and prior shipped as the `--center-prior` defaults: what two-fold cross-validated grid
-/// search (`ocellus eval --tune`) chose on the 100 MIT1003 images of shared/data: both folds
+/// search (`ocellus eval --tune`) chose on the 100-image MIT1003 subset (Judd et al. 2009) the project was tuned on: both folds
 /// chose skin weight 3, prior weight 0.60 and sigma 0.12, and blur 0.06 and 0.04 (we ship
 /// their mean).
 pub const DEFAULT_PRIOR: CenterPrior =
@@ -60,30 +60,31 @@ pub struct EvalArgs {
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Adds the skin-colour channel to an `ocellus:` model with this weight (default 0: none;
-    /// 3 with --center-prior).
-    #[arg(long)]
+    /// 3 with --center-prior). Range: 0..=100.
+    #[arg(long, value_parser = crate::ranges::within(0.0f32, 100.0))]
     pub skin_weight: Option<f32>,
     /// The evaluation-friendly output: skin weight 3, blur 0.05 of the width, centre prior
     /// weight 0.6 with sigma 0.12 of the larger side (chosen by --tune), unless
     /// --skin-weight/--blur/--prior-weight/--prior-sigma say otherwise.
     #[arg(long)]
     pub center_prior: bool,
-    /// Gaussian blur of the map, sigma as a fraction of the image width (default 0, or 0.05 with --center-prior).
-    #[arg(long)]
+    /// Gaussian blur of the map, sigma as a fraction of the image width (default 0, or 0.05
+    /// with --center-prior). Range: 0..=0.5.
+    #[arg(long, value_parser = crate::ranges::within(0.0f32, 0.5))]
     pub blur: Option<f32>,
-    /// Weight of the centre prior in [0, 1].
-    #[arg(long)]
+    /// Weight of the centre prior. Range: 0..=1.
+    #[arg(long, value_parser = crate::ranges::within(0.0f32, 1.0))]
     pub prior_weight: Option<f32>,
-    /// Sigma of the centre prior as a fraction of the larger side.
-    #[arg(long)]
+    /// Sigma of the centre prior as a fraction of the larger side. Range: above 0, at most 2.
+    #[arg(long, value_parser = crate::ranges::above(0.0f32, 2.0))]
     pub prior_sigma: Option<f32>,
     /// Choose, by grid search on half of the images and report on the other half, then swap
     /// (two-fold cross-validation): the skin weight and blur of the map alone, then blur,
     /// weight and sigma of the centre prior. Needs --fixations (selection by CC).
     #[arg(long)]
     pub tune: bool,
-    /// Use only the first N images (natural order).
-    #[arg(long)]
+    /// Use only the first N images (natural order). Range: 1..=1000000.
+    #[arg(long, value_parser = crate::ranges::within(1usize, 1_000_000))]
     pub limit: Option<usize>,
     /// Write per-image metric values to this JSON file.
     #[arg(long)]
@@ -261,30 +262,32 @@ fn score_all(samples: &[Sample], prior: &CenterPrior) -> Result<Vec<Scores>> {
     Ok(scores)
 }
 
-fn print_table(scores: &[Scores]) {
-    println!("{:<10} {:>8} {:>8}", "metric", "mean", "s.e.");
-    let row = |name: &str, v: Vec<f64>| {
+fn print_table(scores: &[Scores]) -> Result<()> {
+    outln!("{:<10} {:>8} {:>8}", "metric", "mean", "s.e.");
+    let row = |name: &str, v: Vec<f64>| -> Result<()> {
         if v.iter().any(|x| x.is_nan()) {
-            println!("{name:<10} {:>8} (needs fixations of at least 2 images)", "n/a");
-            return;
+            outln!("{name:<10} {:>8} (needs fixations of at least 2 images)", "n/a");
+            return Ok(());
         }
         let (m, se) = mean_se(&v);
-        println!("{name:<10} {m:>8.4} {se:>8.4}");
+        outln!("{name:<10} {m:>8.4} {se:>8.4}");
+        Ok(())
     };
     if scores.iter().all(|s| s.density.is_some()) {
         for (k, name) in DENSITY_NAMES.iter().enumerate() {
-            row(name, scores.iter().filter_map(|s| s.density.map(|d| d[k])).collect());
+            row(name, scores.iter().filter_map(|s| s.density.map(|d| d[k])).collect())?;
         }
     } else {
-        println!("CC, SIM and KL need fixation density maps (--fixations).");
+        outln!("CC, SIM and KL need fixation density maps (--fixations).");
     }
     if scores.iter().all(|s| s.location.is_some()) {
         for (k, name) in LOCATION_NAMES.iter().enumerate() {
-            row(name, scores.iter().filter_map(|s| s.location.map(|d| d[k])).collect());
+            row(name, scores.iter().filter_map(|s| s.location.map(|d| d[k])).collect())?;
         }
     } else {
-        println!("NSS, AUC-Judd, AUC-Borji, shuffled AUC and IG need fixation points (--points: binary maps or CSV).");
+        outln!("NSS, AUC-Judd, AUC-Borji, shuffled AUC and IG need fixation points (--points: binary maps or CSV).");
     }
+    Ok(())
 }
 
 fn write_json(
@@ -314,7 +317,7 @@ fn write_json(
     let doc = json!({"model": a.model, "skin_weight": skin_weight(a), "prior": prior, "images": rows});
     std::fs::write(path, serde_json::to_string_pretty(&doc)?)
         .with_context(|| format!("cannot write {}", path.display()))?;
-    println!("per-image values written to {}", path.display());
+    outln!("per-image values written to {}", path.display());
     Ok(())
 }
 
@@ -327,13 +330,15 @@ pub fn run(a: EvalArgs) -> Result<()> {
         return tune::run(&a, &model, &items);
     }
     let samples = data::load_samples(&items, &model)?;
-    println!("{} images, model {}", items.len(), a.model);
+    outln!("{} images, model {}", items.len(), a.model);
     let scores = score_all(&samples, &prior)?;
-    println!(
+    outln!(
         "blur {:.3} of width, centre prior weight {:.2}, sigma {:.2} of the larger side",
-        prior.blur_sigma_frac_width, prior.weight, prior.center_sigma_frac
+        prior.blur_sigma_frac_width,
+        prior.weight,
+        prior.center_sigma_frac
     );
-    print_table(&scores);
+    print_table(&scores)?;
     if let Some(path) = &a.json {
         write_json(path, &a, &prior, &items, &scores)?;
     }

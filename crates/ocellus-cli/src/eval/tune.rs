@@ -52,9 +52,10 @@ fn test_means(scores: &[Vec<[f64; 3]>], c: usize, test: &Range<usize>) -> [f64; 
     [m(0), m(1), m(2)]
 }
 
-fn print_mean(what: &str, r: &[[f64; 3]]) {
+fn print_mean(what: &str, r: &[[f64; 3]]) -> Result<()> {
     let m = |k: usize| r.iter().map(|x| x[k]).sum::<f64>() / r.len() as f64;
-    println!("{what}, cross-validated mean of both folds: CC {:.4} SIM {:.4} KL {:.4}", m(0), m(1), m(2));
+    outln!("{what}, cross-validated mean of both folds: CC {:.4} SIM {:.4} KL {:.4}", m(0), m(1), m(2));
+    Ok(())
 }
 
 /// Runs the two-fold search and prints the choices and held-out scores.
@@ -77,7 +78,7 @@ pub fn run(a: &EvalArgs, model: &Model, items: &[Item]) -> Result<()> {
     for (_, m) in &models[1..] {
         maps.push(data::load_maps(items, m)?);
     }
-    println!("{} images, model {}, two-fold cross-validation by CC", items.len(), a.model);
+    outln!("{} images, model {}, two-fold cross-validation by CC", items.len(), a.model);
     let map_grid: Vec<CenterPrior> = MAP_BLURS
         .iter()
         .map(|&b| CenterPrior { blur_sigma_frac_width: b, weight: 0.0, center_sigma_frac: 0.25 })
@@ -107,7 +108,7 @@ pub fn run(a: &EvalArgs, model: &Model, items: &[Item]) -> Result<()> {
         let c = best(&flat, 0..flat[0].len(), train);
         let (skin_idx, blur) = (c / MAP_BLURS.len(), MAP_BLURS[c % MAP_BLURS.len()]);
         let r = test_means(&flat, c, test);
-        println!(
+        outln!(
             "fold {}, map alone: chosen on {} images: skin weight {}, blur {:.2}; on the other {}: CC {:.4} SIM {:.4} KL {:.4}",
             f + 1,
             train.len(),
@@ -127,7 +128,7 @@ pub fn run(a: &EvalArgs, model: &Model, items: &[Item]) -> Result<()> {
         let c = best(ps, 0..prior_grid.len(), train);
         let p = prior_grid[c];
         let r = test_means(ps, c, test);
-        println!(
+        outln!(
             "fold {}, centre prior: chosen on {} images: blur {:.2}, weight {:.2}, sigma {:.2}; on the other {}: CC {:.4} SIM {:.4} KL {:.4}",
             f + 1,
             train.len(),
@@ -141,7 +142,7 @@ pub fn run(a: &EvalArgs, model: &Model, items: &[Item]) -> Result<()> {
         );
         prior_reported.push(r);
     }
-    print_mean("map alone", &map_reported);
-    print_mean("with centre prior", &prior_reported);
+    print_mean("map alone", &map_reported)?;
+    print_mean("with centre prior", &prior_reported)?;
     Ok(())
 }

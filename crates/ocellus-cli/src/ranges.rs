@@ -1,0 +1,87 @@
+//! The one place where numeric command-line options are checked.
+//!
+//! Every numeric option takes one of these parsers, so a value outside its finite range (NaN,
+//! infinity, zero where zero is meaningless, a size that would allocate gigabytes) is refused
+//! by the parser with the range in the message, before any work starts. Each option's `--help`
+//! states the same range (a test checks that every numeric option's help says "range").
+//! Negative numbers parse as values (`--blur -1` gives the range error, not clap's
+//! "unexpected argument"): `main` enables that for every subcommand.
+
+use std::fmt::Display;
+use std::str::FromStr;
+
+/// A parser of a number in `[lo, hi]` (both ends included).
+pub fn within<T>(lo: T, hi: T) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static
+where
+    T: FromStr + PartialOrd + Display + Copy + Send + Sync + 'static,
+    T::Err: Display,
+{
+    move |s: &str| {
+        let v: T = s.trim().parse().map_err(|e| format!("`{s}` is not a number ({e})"))?;
+        // NaN fails both comparisons, so it is refused here too.
+        if v >= lo && v <= hi {
+            Ok(v)
+        } else {
+            Err(format!("{s} is outside the range {lo}..={hi}"))
+        }
+    }
+}
+
+/// A parser of a number in `(lo, hi]`: above `lo`, at most `hi`.
+pub fn above<T>(lo: T, hi: T) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static
+where
+    T: FromStr + PartialOrd + Display + Copy + Send + Sync + 'static,
+    T::Err: Display,
+{
+    move |s: &str| {
+        let v: T = s.trim().parse().map_err(|e| format!("`{s}` is not a number ({e})"))?;
+        if v > lo && v <= hi {
+            Ok(v)
+        } else {
+            Err(format!("{s} is outside the range: it must be above {lo} and at most {hi}"))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn ends_nan_and_infinity() {
+        let p = within(0.0f64, 1.0);
+        assert_eq!(p("0"), Ok(0.0));
+        assert_eq!(p("1"), Ok(1.0));
+        for bad in ["-0.001", "1.0001", "NaN", "nan", "inf", "-inf", "1e30", "", "x", "0x1"] {
+            assert!(p(bad).is_err(), "{bad}");
+        }
+        let q = above(0.0f64, 1e6);
+        assert!(q("0").is_err() && q("-0").is_err() && q("1e-300").is_ok() && q("1e6").is_ok() && q("1e7").is_err());
+        let n = within(1usize, 10);
+        assert!(n("0").is_err() && n("-1").is_err() && n("1").is_ok() && n("11").is_err() && n("2.5").is_err());
+    }
+
+    proptest! {
+        /// Whatever the text, the parser either refuses it or returns a value in the range
+        /// that equals the text's own parse.
+        #[test]
+        fn accepted_values_lie_in_the_range(s in "\\PC{0,12}", lo in -1e3f64..1e3, span in 0.0f64..1e3) {
+            let hi = lo + span;
+            if let Ok(v) = within(lo, hi)(&s) {
+                prop_assert!(v >= lo && v <= hi && v.is_finite());
+                prop_assert_eq!(Some(v), s.trim().parse::<f64>().ok());
+            }
+            if let Ok(v) = above(lo, hi)(&s) {
+                prop_assert!(v > lo && v <= hi);
+            }
+        }
+
+        #[test]
+        fn numbers_in_range_are_accepted(v in -1e3f64..1e3) {
+            let text = format!("{v}");
+            prop_assert_eq!(within(-1e3, 1e3)(&text), Ok(v));
+            prop_assert_eq!(within(-1e3f64, 1e3)(&format!("{v:e}")), Ok(v));
+        }
+    }
+}
