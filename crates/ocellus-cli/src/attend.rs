@@ -96,6 +96,7 @@ fn create(dir: &Path, name: &str) -> Result<std::io::BufWriter<std::fs::File>> {
 impl Outputs {
     fn new(dir: &Path, overlays: bool) -> Result<Self> {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        ocellus_io::video_writer::check_output(&dir.join("overlays.mp4"))?;
         if overlays {
             std::fs::create_dir_all(dir.join("overlays"))?;
         }
@@ -240,6 +241,9 @@ pub fn run(a: AttendArgs) -> Result<()> {
 pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
     let cfg = a.stream.config(a.deg_per_px)?;
     let pan_tilt = a.pan_tilt.as_deref().map(frames::read_pan_tilt).transpose()?;
+    for d in [a.out.clone(), a.out.join("overlays")] {
+        crate::inputs::check_out_dir(&d, std::slice::from_ref(&a.input))?;
+    }
     let mut out = Outputs::new(&a.out, !a.no_overlays)?;
     let mut engine: Option<StreamEngine> = None;
     let threshold = cfg.chaos.threshold;

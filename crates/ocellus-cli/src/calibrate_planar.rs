@@ -2,7 +2,7 @@
 //! images of a chessboard or from given planar correspondences.
 
 use crate::camera_file::{self, CameraFile};
-use crate::inputs::{collect_images, stem};
+use crate::inputs::{check_out_dir, collect_images, output_stems, stem};
 use crate::overlay::draw_ring;
 use crate::plot::{self, Plot, Series};
 use anyhow::{bail, Context, Result};
@@ -128,6 +128,9 @@ pub fn run_chessboard(a: ChessboardArgs) -> Result<()> {
     let (cols, rows) = parse_pair(&a.board, "--board", BOARD_RANGE)?;
     let square = parse_length_mm(&a.square)?;
     let files = collect_images(&a.images)?;
+    output_stems(&files)?;
+    check_out_dir(&a.out, &files)?;
+    check_out_dir(&a.out.join("corners"), &files)?;
     std::fs::create_dir_all(a.out.join("corners")).with_context(|| format!("cannot create {}", a.out.display()))?;
     let object: Vec<[f64; 2]> =
         (0..rows).flat_map(|r| (0..cols).map(move |c| [c as f64 * square, r as f64 * square])).collect();

@@ -142,6 +142,7 @@ pub fn run(a: LogPolarArgs) -> Result<()> {
     let t = std::time::Instant::now();
     let map = LogPolarMap::new(&cfg, w, h)?;
     let build_ms = t.elapsed().as_secs_f64() * 1e3;
+    crate::inputs::check_out_dir(&a.out, std::slice::from_ref(path))?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
     let t = std::time::Instant::now();
     write_foveated(&map, &img.to_u8(), &a.out.join("cortex.png"), &a.out.join("inverse.png"))?;
@@ -201,7 +202,13 @@ fn to_rgb8(p: [&Plane<f32>; 3]) -> Plane<[u8; 3]> {
 /// when ffmpeg is installed.
 fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
     let cortex_dir = a.out.join("cortex");
+    for d in [&a.out, &cortex_dir] {
+        crate::inputs::check_out_dir(d, &[input.to_path_buf()])?;
+    }
     std::fs::create_dir_all(&cortex_dir).with_context(|| format!("cannot create {}", cortex_dir.display()))?;
+    for v in ["cortex.mp4", "inverse.mp4"] {
+        ocellus_io::video_writer::check_output(&a.out.join(v))?;
+    }
     let mut state: Option<(LogPolarMap, Scratch, Option<VideoWriter>, Option<VideoWriter>)> = None;
     let (mut out, mut spent) = (Vec::new(), Vec::new());
     let n = for_each_frame(input, None, |k, frame| {

@@ -106,6 +106,8 @@ pub fn run(a: SaliencyArgs) -> Result<()> {
         return Ok(());
     }
     let files = inputs::collect_images(&a.images)?;
+    inputs::output_stems(&files)?;
+    inputs::check_out_dir(&a.out, &files)?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create output folder {}", a.out.display()))?;
     let bar = if files.len() > 1 {
         let b = ProgressBar::new(files.len() as u64);

@@ -31,6 +31,9 @@ pub struct SurpriseArgs {
 pub fn run(a: SurpriseArgs) -> Result<()> {
     let cfg = a.stream.config(0.1)?;
     let maps = a.out.join("surprise");
+    for d in [&a.out, &maps] {
+        crate::inputs::check_out_dir(d, std::slice::from_ref(&a.input))?;
+    }
     std::fs::create_dir_all(&maps).with_context(|| format!("cannot create {}", maps.display()))?;
     let csv_path = a.out.join("surprise.csv");
     let mut csv = std::io::BufWriter::new(

@@ -1,7 +1,7 @@
 //! `ocellus undistort`: removes lens distortion from images with a calibrated camera.
 
 use crate::camera_file;
-use crate::inputs::{collect_images, stem};
+use crate::inputs::{check_out_dir, collect_images, output_stems};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ocellus_geometry::distortion::{remap_bilinear, undistort_maps};
@@ -31,10 +31,12 @@ type RemapTables = ((usize, usize), Plane<f32>, Plane<f32>);
 pub fn run(a: UndistortArgs) -> Result<()> {
     let cam = camera_file::read(&a.camera)?;
     let files = collect_images(&a.images)?;
+    let stems = output_stems(&files)?;
+    check_out_dir(&a.out, &files)?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
     // Remap tables for the current image size.
     let mut maps: Option<RemapTables> = None;
-    for f in &files {
+    for (f, name) in files.iter().zip(&stems) {
         let img = ocellus_io::read_image(f).with_context(|| format!("cannot read {}", f.display()))?.to_u8();
         let size = img.size();
         if let Some([w, h]) = cam.image_size {
@@ -55,7 +57,7 @@ pub fn run(a: UndistortArgs) -> Result<()> {
         let out = image::RgbImage::from_fn(size.0 as u32, size.1 as u32, |x, y| {
             image::Rgb(std::array::from_fn(|c| channels[c].get(x as usize, y as usize).round().clamp(0.0, 255.0) as u8))
         });
-        let path = a.out.join(format!("{}.png", stem(f)));
+        let path = a.out.join(format!("{name}.png"));
         ocellus_io::write_png(&path, &out)?;
     }
     outln!("{} images undistorted into {}", files.len(), a.out.display());

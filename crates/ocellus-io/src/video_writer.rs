@@ -31,6 +31,20 @@ fn invalid(path: &Path, reason: String) -> IoError {
     IoError::Invalid { path: path.into(), reason }
 }
 
+/// Checks that a video can be written at `path` (not a folder; its folder exists), so that a
+/// command can refuse before it starts work rather than when the first frame is ready.
+pub fn check_output(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        return Err(invalid(path, "is a folder; the video needs a file name".into()));
+    }
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        if !parent.is_dir() {
+            return Err(invalid(path, format!("folder {} does not exist", parent.display())));
+        }
+    }
+    Ok(())
+}
+
 impl VideoWriter {
     /// Starts ffmpeg writing `path` (overwritten) at `fps` frames per second; `Ok(None)` when
     /// ffmpeg is not installed. Width and height must be even (the encoder's 4:2:0 chroma).
@@ -44,14 +58,7 @@ impl VideoWriter {
                 format!("frame rate {fps} fps is outside {}..={}", FPS_RANGE.start(), FPS_RANGE.end()),
             ));
         }
-        if path.is_dir() {
-            return Err(invalid(path, "is a folder; the video needs a file name".into()));
-        }
-        if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-            if !parent.is_dir() {
-                return Err(invalid(path, format!("folder {} does not exist", parent.display())));
-            }
-        }
+        check_output(path)?;
         let spawned = Command::new("ffmpeg")
             .args(["-v", "error", "-nostdin", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24", "-s"])
             .arg(format!("{width}x{height}"))
