@@ -55,6 +55,7 @@ pub fn run(a: TriangulateArgs) -> Result<()> {
         bail!("--seed-form works with exactly two cameras");
     }
     let ps: Vec<Matrix3x4<f64>> = a.cameras.iter().map(|c| read_camera(c)).collect::<Result<_>>()?;
+    ocellus_geometry::triangulate::check_rig(&ps).context("the --camera files cannot triangulate")?;
     let rows = ocellus_io::csv::read_rows(&a.matches, 2 * ps.len(), "a pixel 'u,v' per camera")?;
     let mut out = std::io::BufWriter::new(
         std::fs::File::create(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?,
@@ -86,5 +87,13 @@ pub fn run(a: TriangulateArgs) -> Result<()> {
     }
     out.flush()?;
     outln!("{n} points triangulated from {} cameras ({behind} behind a camera); wrote {}", ps.len(), a.out.display());
+    if n > 0 && behind == n {
+        bail!(
+            "every point lies behind a camera (column in_front is 0 for all {n}): the matches or the cameras are wrong"
+        );
+    }
+    if behind > 0 {
+        errln!("warning: {behind} of {n} points lie behind a camera (in_front = 0 in {})", a.out.display());
+    }
     Ok(())
 }

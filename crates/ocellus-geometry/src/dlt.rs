@@ -41,6 +41,22 @@ fn check(points3: &[[f64; 3]], points2: &[[f64; 2]]) -> Result<()> {
     Ok(())
 }
 
+/// Refuses a fitted P without perspective. Points an affine camera could have made are fitted
+/// exactly by a P whose third row has a vanishing rotation part; scaling that row to unit norm
+/// would then report focal lengths of 1e14 px with zero reprojection error.
+fn check_perspective(p: &Matrix3x4<f64>) -> Result<()> {
+    let third = Vector3::new(p[(2, 0)], p[(2, 1)], p[(2, 2)]).norm();
+    let top = p.fixed_view::<2, 3>(0, 0).norm();
+    if third <= 1e-9 * top {
+        return Err(GeometryError::Degenerate(
+            "the points fit a camera without perspective (an affine camera: P's third row vanishes); \
+             use points spread in depth, seen by a perspective camera"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
 /// The seed's linear DLT with `p34 = 1`.
 pub fn dlt_linear(points3: &[[f64; 3]], points2: &[[f64; 2]]) -> Result<Matrix3x4<f64>> {
     check(points3, points2)?;
@@ -63,6 +79,7 @@ pub fn dlt_linear(points3: &[[f64; 3]], points2: &[[f64; 2]]) -> Result<Matrix3x
     if p.iter().any(|v| !v.is_finite()) {
         return Err(GeometryError::Degenerate("non-finite solution".into()));
     }
+    check_perspective(&p)?;
     Ok(p)
 }
 
@@ -129,6 +146,7 @@ pub fn dlt(points3: &[[f64; 3]], points2: &[[f64; 2]]) -> Result<Matrix3x4<f64>>
     if scale.is_nan() || scale <= 0.0 || p.iter().any(|v| !v.is_finite()) {
         return Err(GeometryError::Degenerate("no finite solution".into()));
     }
+    check_perspective(&p)?;
     p /= scale;
     // Points must be in front: make the mean depth positive.
     let depth: f64 = points3.iter().map(|x| (p.row(2) * Vector4::new(x[0], x[1], x[2], 1.0))[0]).sum();
@@ -284,5 +302,23 @@ mod tests {
         assert!(matches!(dlt_linear(&nan, &p2), Err(GeometryError::NonFinite { index: 3, .. })));
         assert!(dlt(&p3, &p2[..9]).is_err());
         assert!(decompose(&Matrix3x4::zeros()).is_err());
+    }
+
+    #[test]
+    fn points_of_an_affine_camera_are_refused() {
+        // An affine camera (third row 0 0 0 1): the DLT would fit it exactly with an
+        // enormous focal length; it must say that the data has no perspective instead.
+        let a = Matrix3x4::new(800.0, 10.0, 5.0, 320.0, -4.0, 790.0, 12.0, 240.0, 0.0, 0.0, 0.0, 1.0);
+        let (p3, _) = data(&camera(1.0), 6, 1.0, 0.0, 3);
+        let p2: Vec<[f64; 2]> = p3
+            .iter()
+            .map(|x| {
+                let h = a * Vector4::new(x[0], x[1], x[2], 1.0);
+                [h.x / h.z, h.y / h.z]
+            })
+            .collect();
+        for r in [dlt(&p3, &p2), dlt_linear(&p3, &p2)] {
+            assert!(matches!(&r, Err(GeometryError::Degenerate(m)) if m.contains("perspective")), "{r:?}");
+        }
     }
 }

@@ -6,7 +6,9 @@
 //! - [`n_view`]: the homogeneous form for any number of views: `x p3 - p1`, `y p3 - p2` rows
 //!   of a 2N x 4 system, the solution the smallest eigenvector of A^T A.
 //!
-//! Each result says whether the point is in front of every camera.
+//! Each result says whether the point is in front of every camera. [`check_rig`] refuses
+//! camera sets that cannot triangulate at all (a singular projection matrix, or every camera
+//! at one centre: a pure rotation sees no depth).
 
 use crate::{GeometryError, Result};
 use nalgebra::{Matrix3, Matrix3x4, Matrix4, SymmetricEigen, Vector3, Vector4};
@@ -27,6 +29,48 @@ fn in_front<'a>(mut ps: impl Iterator<Item = &'a Matrix3x4<f64>>, x: &Vector3<f6
         let det = p.fixed_view::<3, 3>(0, 0).determinant();
         w * det.signum() > 0.0
     })
+}
+
+/// The centre of a finite projective camera, `-M^-1 p4`, or an error when `M` (the left 3x3
+/// of `P`) is singular: an all-zero or affine camera has no centre in front of it.
+pub fn camera_centre(p: &Matrix3x4<f64>) -> Result<Vector3<f64>> {
+    let m = p.fixed_view::<3, 3>(0, 0).into_owned();
+    let norm = m.norm();
+    // det scales with the cube of the matrix, so compare it with the cube of its norm.
+    let det = m.determinant();
+    if !(norm > 0.0 && norm.is_finite()) || det.abs() <= 1e-12 * norm.powi(3) {
+        return Err(GeometryError::Degenerate(
+            "the projection matrix is singular (all zero, or an affine camera without a centre)".into(),
+        ));
+    }
+    let inv = m.try_inverse().ok_or_else(|| GeometryError::Degenerate("the projection matrix is singular".into()))?;
+    Ok(-(inv * p.fixed_view::<3, 1>(0, 3)))
+}
+
+/// Checks that `ps` can triangulate: every matrix finite and non-singular, and at least two
+/// centres apart by more than 1e-9 of the rig's size (cameras at one centre differ only by a
+/// rotation, and a rotation carries no depth). The error names the camera (0-based).
+pub fn check_rig(ps: &[Matrix3x4<f64>]) -> Result<()> {
+    if ps.len() < 2 {
+        return Err(GeometryError::TooFewViews { what: "triangulation", need: 2, got: ps.len() });
+    }
+    let mut centres = Vec::with_capacity(ps.len());
+    for (k, p) in ps.iter().enumerate() {
+        if p.iter().any(|v| !v.is_finite()) {
+            return Err(GeometryError::Invalid(format!("camera {k}: the projection matrix is not finite")));
+        }
+        let c = camera_centre(p).map_err(|e| GeometryError::Degenerate(format!("camera {k}: {e}")))?;
+        centres.push(c);
+    }
+    let size = centres.iter().map(|c| c.norm()).fold(1.0, f64::max);
+    let baseline = centres.iter().flat_map(|a| centres.iter().map(move |b| (a - b).norm())).fold(0.0, f64::max);
+    if baseline <= 1e-9 * size {
+        return Err(GeometryError::Degenerate(
+            "every camera has the same centre (identical cameras or a pure rotation): there is no baseline to triangulate from"
+                .into(),
+        ));
+    }
+    Ok(())
 }
 
 /// The seed's two-view least squares (P scaled to p34 = 1 internally).
@@ -178,6 +222,32 @@ mod tests {
                 PinholeCamera { k, r, t: Vector3::new(-0.3 * i as f64, 0.0, 0.5) }
             })
             .collect()
+    }
+
+    #[test]
+    fn rigs_that_cannot_triangulate_are_refused() {
+        let ps: Vec<_> = cams().iter().map(|c| c.projection_matrix()).collect();
+        assert!(check_rig(&ps).is_ok() && check_rig(&ps[..2]).is_ok());
+        assert!(matches!(check_rig(&ps[..1]), Err(GeometryError::TooFewViews { .. })));
+        // Identical cameras, and one centre with two orientations (a pure rotation).
+        assert!(matches!(check_rig(&[ps[1], ps[1]]), Err(GeometryError::Degenerate(_))));
+        let c = cams()[1];
+        let turned = PinholeCamera { r: *Rotation3::from_euler_angles(0.0, 0.4, 0.1).matrix() * c.r, ..c };
+        let turned = PinholeCamera { t: -(turned.r * c.centre()), ..turned };
+        assert!((turned.centre() - c.centre()).norm() < 1e-12);
+        let e = check_rig(&[c.projection_matrix(), turned.projection_matrix()]).unwrap_err();
+        assert!(e.to_string().contains("same centre"), "{e}");
+        // An all-zero matrix and an affine camera, named by index.
+        let e = check_rig(&[ps[0], Matrix3x4::zeros()]).unwrap_err();
+        assert!(e.to_string().contains("camera 1") && e.to_string().contains("singular"), "{e}");
+        let affine = Matrix3x4::new(800.0, 0.0, 0.0, 320.0, 0.0, 800.0, 0.0, 240.0, 0.0, 0.0, 0.0, 1.0);
+        assert!(check_rig(&[affine, ps[0]]).is_err());
+        let mut nan = ps[0];
+        nan[(1, 2)] = f64::NAN;
+        assert!(matches!(check_rig(&[nan, ps[1]]), Err(GeometryError::Invalid(_))));
+        // The centre is where P maps to zero.
+        let h = ps[2] * camera_centre(&ps[2]).unwrap().push(1.0);
+        assert!(h.norm() < 1e-9, "{h}");
     }
 
     #[test]

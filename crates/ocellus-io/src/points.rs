@@ -2,10 +2,11 @@
 //!
 //! One point per line, `x,y` in pixels of the stimulus: x to the right, y down, origin at the
 //! top-left corner, pixel centres at integer coordinates (so `3,5` is the pixel in column 3,
-//! row 5, and `3.4,5.6` rounds to it). Separators may be commas, semicolons, tabs or spaces;
-//! further columns (a subject id, a duration) are ignored. Blank lines and lines starting with
-//! `#` are skipped, and so is a first line whose first two fields are not numbers (a header);
-//! see [`crate::csv`].
+//! row 5, and `3.4,5.6` rounds to it). Separators may be commas, semicolons, tabs or spaces.
+//! A line must hold exactly the two numbers: further columns (a subject id, a duration) are an
+//! error, not silently dropped, so a file of another layout is never misread. Blank lines and
+//! lines starting with `#` are skipped, and so is a first line with a field that is not a
+//! number (a header); see [`crate::csv`].
 
 use crate::{read_bytes, Result};
 use std::path::Path;
@@ -46,8 +47,10 @@ mod tests {
 
     #[test]
     fn header_comments_separators_and_extra_columns() {
-        let v = p("x,y,subject\n# a comment\n1,2,7\n\n3.5;4\n5\t6\n 7 8 \n").unwrap();
+        let v = p("x,y\n# a comment\n1,2\n\n3.5;4\n5\t6\n 7 8 \n").unwrap();
         assert_eq!(v, vec![[1.0, 2.0], [3.5, 4.0], [5.0, 6.0], [7.0, 8.0]]);
+        let e = p("x,y,subject\n1,2,7\n").unwrap_err().to_string();
+        assert!(e.contains("line 2") && e.contains("got 3"), "{e}");
     }
 
     #[test]
@@ -55,7 +58,8 @@ mod tests {
         let e = p("1,2\n3,abc\n").unwrap_err().to_string();
         assert!(e.contains("line 2"), "{e}");
         assert!(p("1,2\nNaN,3\n").unwrap_err().to_string().contains("non-finite"));
-        assert!(p("1\n").is_ok(), "a lone first line is a header");
+        assert!(p("1\n").is_err(), "a short first line of numbers is data, not a header");
+        assert!(p("x\n").unwrap().is_empty(), "a lone word is a header");
         assert!(p("1,2\n7\n").is_err());
         assert!(parse(&[0xff, 0xfe], Path::new("t.csv")).is_err());
     }
