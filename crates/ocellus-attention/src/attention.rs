@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 
 /// Parameters of [`Attention`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct AttentionConfig {
     /// Habituation added at the attended place per frame.
     pub habituation_gain: f32,
@@ -112,6 +113,7 @@ impl Reason {
 
 /// Where attention is in one frame.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Fixation {
     /// Frame index.
     pub frame: usize,

@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 
 /// Blur and centre-prior parameters (fractions of the image size, so they apply to any size).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CenterPrior {
     /// Blur sigma as a fraction of the image width (0: no blur).
     pub blur_sigma_frac_width: f32,

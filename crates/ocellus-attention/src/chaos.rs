@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 
 /// Parameters of [`ChaosDegree`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ChaosConfig {
     /// Histogram bins of the motion maps.
     pub bins: usize,

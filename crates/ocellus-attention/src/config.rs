@@ -59,6 +59,7 @@ pub enum GaborBorder {
 /// on a `size` x `size` grid centred on the pixel. Each kernel has its mean removed and is
 /// scaled to unit L2 norm. Response `M_theta = |I * G_0| + |I * G_{pi/2}|`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct GaborConfig {
     /// Side of the square kernel in pixels (odd).
     pub size: usize,
@@ -86,7 +87,7 @@ pub enum GlobalInhibition {
 
 /// The competition operator N(.) (SPEC 1.6).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", tag = "kind")]
+#[serde(rename_all = "snake_case", tag = "kind", deny_unknown_fields)]
 pub enum Normalization {
     /// Iterative difference of Gaussians (Itti & Koch 2001):
     /// `M <- max(0, M + M * G_ex - M * G_inh - C_inh)`, with the Gaussians
@@ -148,6 +149,7 @@ impl ChannelKind {
 
 /// One channel and its gain.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ChannelConfig {
     /// Which feature.
     pub kind: ChannelKind,
@@ -167,6 +169,7 @@ pub enum Combination {
 
 /// All parameters of the saliency pipeline.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SaliencyConfig {
     /// Name of the preset this started from (informational).
     pub preset: String,

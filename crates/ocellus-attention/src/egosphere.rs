@@ -32,6 +32,7 @@ pub fn wrap_deg(a: f32) -> f32 {
 
 /// How image pixels map to directions.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ViewGeometry {
     /// Image width in pixels.
     pub width: usize,
@@ -90,6 +91,7 @@ pub fn separation_deg(a: (f32, f32), b: (f32, f32)) -> f32 {
 
 /// One Gaussian blob on the sphere.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Blob {
     /// Centre azimuth, degrees.
     pub az: f32,
@@ -122,6 +124,7 @@ impl Blob {
 
 /// A decaying sum of blobs (habituation, inhibition of return).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct BlobField {
     /// The blobs.
     pub blobs: Vec<Blob>,

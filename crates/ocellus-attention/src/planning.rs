@@ -66,6 +66,7 @@ impl ContextWeight {
 
 /// Parameters of [`ViewPlanner`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PlannerConfig {
     /// Candidate pan angles, degrees.
     pub candidates_deg: Vec<f64>,
@@ -128,6 +129,7 @@ impl PlannerConfig {
 
 /// Gains of one candidate direction.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Candidate {
     /// Pan angle, degrees.
     pub pan_deg: f64,
@@ -143,6 +145,7 @@ pub struct Candidate {
 
 /// The planner's choice and everything behind it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Decision {
     /// The chosen pan angle, degrees.
     pub pan_deg: f64,

@@ -27,6 +27,7 @@ use std::time::{Duration, Instant};
 
 /// Everything a stream needs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StreamConfig {
     /// The saliency pipeline; a flicker channel is added if it has none.
     pub saliency: SaliencyConfig,

@@ -31,6 +31,7 @@ pub enum KlDirection {
 
 /// Parameters of [`Surprise`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SurpriseConfig {
     /// Forgetting factor `xi` in (0, 1] (iLab: 0.7). Smaller forgets faster.
     pub update_factor: f64,

@@ -66,6 +66,16 @@ mod tests {
         assert!(load("stb", Some(&f)).is_err(), "even Gabor size must be rejected");
         std::fs::write(&f, "no_such_field = [").unwrap();
         assert!(load("stb", Some(&f)).is_err());
+        // A misspelt key is named, at the top level and inside a table.
+        for (text, key) in [
+            ("map_levle = 3\n", "map_levle"),
+            ("[gabor]\nsiz = 15\n", "siz"),
+            ("[normalization]\nkind = \"iterative\"\niteratons = 2\n", "iteratons"),
+        ] {
+            std::fs::write(&f, text).unwrap();
+            let e = format!("{:#}", load("ace2009", Some(&f)).unwrap_err());
+            assert!(e.contains(key), "{text}: {e}");
+        }
         assert!(load("nope", None).is_err());
     }
 }

@@ -136,6 +136,9 @@ pub fn run(a: OdometryArgs) -> Result<()> {
     let mut failures = 0usize;
     let t0 = std::time::Instant::now();
     let n = for_each_frame(input, None, |k, frame| {
+        if k == 0 {
+            camera_file::check_frame_size(&cam, camera, "the first frame", frame.size())?;
+        }
         let mut grey = frame.to_luma8();
         if distorted {
             let (mx, my) = maps.get_or_insert_with(|| undistort_maps(&cam.intrinsics, &d, grey.width(), grey.height()));

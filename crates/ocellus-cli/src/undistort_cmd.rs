@@ -2,7 +2,7 @@
 
 use crate::camera_file;
 use crate::inputs::{check_out_dir, collect_images, output_stems};
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 use ocellus_geometry::distortion::{remap_bilinear, undistort_maps};
 use ocellus_image::Plane;
@@ -39,11 +39,7 @@ pub fn run(a: UndistortArgs) -> Result<()> {
     for (f, name) in files.iter().zip(&stems) {
         let img = ocellus_io::read_image(f).with_context(|| format!("cannot read {}", f.display()))?.to_u8();
         let size = img.size();
-        if let Some([w, h]) = cam.image_size {
-            if (w, h) != size {
-                bail!("{} is {}x{}, the camera was calibrated at {w}x{h}", f.display(), size.0, size.1);
-            }
-        }
+        camera_file::check_frame_size(&cam, &a.camera, &f.display().to_string(), size)?;
         if maps.as_ref().map(|m| m.0) != Some(size) {
             maps = None;
         }

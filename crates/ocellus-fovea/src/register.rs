@@ -34,6 +34,7 @@ pub enum Mode {
 
 /// Parameters of the registration.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RegisterOptions {
     /// Direct or spectrum.
     pub mode: Mode,

@@ -16,6 +16,7 @@ use ocellus_image::Plane;
 
 /// Parameters of the vergence search.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct VergenceOptions {
     /// Log rings.
     pub rings: usize,

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 /// Intrinsic parameters in pixels: focal lengths `f kx`, `f ky`, principal point, skew.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Intrinsics {
     /// Focal length times horizontal pixels per unit length, pixels.
     pub fx: f64,

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 /// Distortion coefficients (dimensionless, on normalized coordinates).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Distortion {
     /// Radial r^2 coefficient.
     pub k1: f64,

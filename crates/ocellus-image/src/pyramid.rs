@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 /// The 1D low-pass kernel of a pyramid and where its origin lies.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PyramidKernel {
     /// Taps (any positive weights; normalized to sum 1 on construction).
     pub taps: Vec<f32>,

@@ -15,6 +15,7 @@ pub fn moved_by_camera(pose: &Pose2, camera_right: f64, camera_forward: f64, tur
 
 /// Where the camera sits relative to the rotation centre, metres (robot frame).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Mount {
     /// To the right of the rotation centre, metres.
     pub right_m: f64,

@@ -25,6 +25,7 @@ use ocellus_image::Plane;
 
 /// Parameters of the robust measurement.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RobustConfig {
     /// The integer search (all windows are used; none is dropped for being on the border).
     pub flow: SadFlowConfig,

@@ -18,6 +18,7 @@ use ocellus_image::{dispatch_kernel, Backend, Plane};
 
 /// Parameters of the flow measurement (the seed's defaults).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SadFlowConfig {
     /// Side of the central region searched, pixels.
     pub region: usize,

@@ -31,6 +31,7 @@ pub enum Mode {
 
 /// Configuration of [`VisualOdometry`].
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct OdometryConfig {
     /// Camera height above the floor, metres.
     pub height_m: f64,

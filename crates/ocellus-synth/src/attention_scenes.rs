@@ -34,6 +34,7 @@ pub enum Scenario {
 
 /// A rectangle in frame pixels: top-left corner and size.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Rect {
     /// Left column.
     pub x: usize,
@@ -54,6 +55,7 @@ impl Rect {
 
 /// Parameters of a sequence.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SceneConfig {
     /// The scenario.
     pub scenario: Scenario,
@@ -128,6 +130,7 @@ impl SceneConfig {
 
 /// Ground truth of one frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct FrameTruth {
     /// Frame index.
     pub frame: usize,

@@ -31,6 +31,7 @@ pub enum Wall {
 
 /// A poster landmark: centre `x_m` along the wall, at camera height.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Poster {
     /// Position along the corridor, metres.
     pub x_m: f64,
@@ -42,6 +43,7 @@ pub struct Poster {
 
 /// A person: a vertical panel across the corridor at `x_m`, centred at `y_m`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Person {
     /// Distance along the corridor, metres.
     pub x_m: f64,
@@ -55,6 +57,7 @@ pub struct Person {
 
 /// Geometry and camera of the corridor.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CorridorConfig {
     /// Length, metres.
     pub length_m: f64,

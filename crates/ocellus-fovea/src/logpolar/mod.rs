@@ -43,6 +43,7 @@ use std::f64::consts::TAU;
 
 /// Parameters of a log-polar map.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct LogPolarConfig {
     /// Log rings R between `fovea_radius` and `max_radius`.
     pub rings: usize,
