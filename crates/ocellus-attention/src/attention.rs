@@ -69,25 +69,24 @@ impl Default for AttentionConfig {
 impl AttentionConfig {
     /// Checks the ranges.
     pub fn validate(&self) -> Result<()> {
-        let pos = [
-            self.habituation_gain,
-            self.habituation_tau_frames,
-            self.habituation_threshold,
-            self.habituation_sigma_deg,
-            self.ior_amplitude,
-            self.ior_tau_frames,
-            self.ior_sigma_deg,
-            self.egosphere_deg_per_cell,
-        ];
-        let ok = pos.iter().all(|v| v.is_finite() && *v > 0.0)
-            && self.surprise_threshold_bits.is_finite()
-            && self.min_saccade_deg.is_finite()
-            && self.min_saccade_deg >= 0.0;
-        if ok {
-            Ok(())
-        } else {
-            Err(AttentionError::InvalidConfig(format!("attention {self:?}: rates, sizes and thresholds must be > 0")))
-        }
+        use ocellus_image::check;
+        (|| {
+            for (name, v) in [
+                ("habituation_gain", self.habituation_gain),
+                ("habituation_tau_frames", self.habituation_tau_frames),
+                ("habituation_threshold", self.habituation_threshold),
+                ("habituation_sigma_deg", self.habituation_sigma_deg),
+                ("ior_amplitude", self.ior_amplitude),
+                ("ior_tau_frames", self.ior_tau_frames),
+                ("ior_sigma_deg", self.ior_sigma_deg),
+                ("egosphere_deg_per_cell", self.egosphere_deg_per_cell),
+            ] {
+                check::positive(name, v)?;
+            }
+            check::finite("surprise_threshold_bits", self.surprise_threshold_bits)?;
+            check::non_negative("min_saccade_deg", self.min_saccade_deg)
+        })()
+        .map_err(AttentionError::InvalidConfig)
     }
 }
 

@@ -28,18 +28,13 @@ pub struct CenterPrior {
 impl CenterPrior {
     /// Checks the ranges.
     pub fn validate(&self) -> Result<()> {
-        let ok = self.blur_sigma_frac_width.is_finite()
-            && self.blur_sigma_frac_width >= 0.0
-            && (0.0..=1.0).contains(&self.weight)
-            && self.center_sigma_frac.is_finite()
-            && self.center_sigma_frac > 0.0;
-        if ok {
-            Ok(())
-        } else {
-            Err(AttentionError::InvalidConfig(format!(
-                "center prior {self:?}: need blur >= 0, weight in [0, 1], sigma > 0"
-            )))
-        }
+        use ocellus_image::check;
+        (|| {
+            check::within("blur (sigma, fraction of the width)", self.blur_sigma_frac_width, 0.0, 0.5)?;
+            check::within("centre prior weight", self.weight, 0.0, 1.0)?;
+            check::within("centre prior sigma (fraction of the larger side)", self.center_sigma_frac, 1e-6, 2.0)
+        })()
+        .map_err(AttentionError::InvalidConfig)
     }
 
     /// Applies blur and prior to a map at the map level (`map`, any size) and returns it at

@@ -44,20 +44,14 @@ impl Default for ChaosConfig {
 impl ChaosConfig {
     /// Checks the ranges.
     pub fn validate(&self) -> Result<()> {
-        let ok = (2..=65_536).contains(&self.bins)
-            && self.max_difference.is_finite()
-            && self.max_difference > 0.0
-            && self.empty_bin_probability.is_finite()
-            && self.empty_bin_probability > 0.0
-            && self.empty_bin_probability < 0.1
-            && self.threshold.is_finite();
-        if ok {
-            Ok(())
-        } else {
-            Err(AttentionError::InvalidConfig(format!(
-                "chaos {self:?}: need 2..=65536 bins, max_difference > 0, empty_bin_probability in (0, 0.1), finite threshold"
-            )))
-        }
+        use ocellus_image::check;
+        (|| {
+            check::within("chaos bins", self.bins, 2, 65_536)?;
+            check::positive("chaos max_difference", self.max_difference)?;
+            check::between("chaos empty_bin_probability", self.empty_bin_probability, 0.0, 0.1)?;
+            check::finite("chaos threshold", self.threshold)
+        })()
+        .map_err(AttentionError::InvalidConfig)
     }
 }
 

@@ -45,13 +45,19 @@ pub struct ViewGeometry {
 impl ViewGeometry {
     /// Checks the values.
     pub fn validate(&self) -> Result<()> {
-        if self.width == 0 || self.height == 0 || !(self.deg_per_px.is_finite() && self.deg_per_px > 0.0) {
-            return Err(AttentionError::InvalidConfig(format!("view geometry {self:?}")));
-        }
-        if self.width as f32 * self.deg_per_px > 360.0 {
-            return Err(AttentionError::InvalidConfig(format!("field of view over 360 degrees: {self:?}")));
-        }
-        Ok(())
+        use ocellus_image::check;
+        (|| {
+            check::within("view width", self.width, 1, usize::MAX)?;
+            check::within("view height", self.height, 1, usize::MAX)?;
+            check::positive("deg_per_px", self.deg_per_px)?;
+            check::within(
+                "horizontal field of view (width x deg_per_px, degrees)",
+                self.width as f32 * self.deg_per_px,
+                0.0,
+                360.0,
+            )
+        })()
+        .map_err(AttentionError::InvalidConfig)
     }
 
     /// Direction (azimuth, elevation) in degrees of pixel (x, y) for a camera at (pan, tilt).

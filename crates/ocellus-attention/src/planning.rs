@@ -111,19 +111,28 @@ impl Default for PlannerConfig {
 
 impl PlannerConfig {
     fn validate(&self) -> Result<()> {
-        let pos = [self.hfov_deg, self.max_range_m, self.bearing_sigma_deg, self.deg_per_cell, self.min_distance_cells];
-        let ok = !self.candidates_deg.is_empty()
-            && self.candidates_deg.iter().all(|c| c.is_finite())
-            && pos.iter().all(|v| v.is_finite() && *v > 0.0)
-            && self.hfov_deg < 180.0
-            && self.interest_min_bits.is_finite()
-            && (0.0..=1.0).contains(&self.interest_frac)
-            && self.chaos_threshold.is_finite();
-        if ok {
-            Ok(())
-        } else {
-            Err(AttentionError::InvalidConfig(format!("planner {self:?}")))
-        }
+        use ocellus_image::check;
+        (|| {
+            if self.candidates_deg.is_empty() {
+                return Err("the planner needs at least one candidate direction".to_string());
+            }
+            for c in &self.candidates_deg {
+                check::finite("candidate direction (degrees)", *c)?;
+            }
+            check::between("hfov_deg", self.hfov_deg, 0.0, 180.0)?;
+            for (name, v) in [
+                ("max_range_m", self.max_range_m),
+                ("bearing_sigma_deg", self.bearing_sigma_deg),
+                ("deg_per_cell", self.deg_per_cell),
+                ("min_distance_cells", self.min_distance_cells),
+            ] {
+                check::positive(name, v)?;
+            }
+            check::finite("interest_min_bits", self.interest_min_bits)?;
+            check::within("interest_frac", self.interest_frac, 0.0, 1.0)?;
+            check::finite("chaos_threshold", self.chaos_threshold)
+        })()
+        .map_err(AttentionError::InvalidConfig)
     }
 }
 

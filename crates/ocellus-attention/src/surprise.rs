@@ -65,20 +65,14 @@ impl SurpriseConfig {
 
     /// Checks the ranges.
     pub fn validate(&self) -> Result<()> {
-        let ok = self.update_factor > 0.0
-            && self.update_factor < 1.0
-            && (1..=16).contains(&self.models)
-            && self.data_scale.is_finite()
-            && self.data_scale > 0.0
-            && self.alpha_floor.is_finite()
-            && self.alpha_floor > 0.0;
-        if ok {
-            Ok(())
-        } else {
-            Err(AttentionError::InvalidConfig(format!(
-                "surprise {self:?}: need update_factor in (0, 1), models in 1..=16, data_scale > 0, alpha_floor > 0"
-            )))
-        }
+        use ocellus_image::check;
+        (|| {
+            check::between("surprise update_factor", self.update_factor, 0.0, 1.0)?;
+            check::within("surprise models", self.models, 1, 16)?;
+            check::positive("surprise data_scale", self.data_scale)?;
+            check::positive("surprise alpha_floor", self.alpha_floor)
+        })()
+        .map_err(AttentionError::InvalidConfig)
     }
 }
 

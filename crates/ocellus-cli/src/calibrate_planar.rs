@@ -137,7 +137,7 @@ pub fn run_chessboard(a: ChessboardArgs) -> Result<()> {
     let detections: Vec<Result<Detection>> = files
         .par_iter()
         .map(|f| {
-            let img = ocellus_io::read_image(f)?;
+            let img = crate::budget::read_image(f)?;
             let found =
                 find_chessboard(&grey(&img), cols, rows, &ChessboardOptions::default()).map_err(|e| e.to_string());
             Ok((img.to_u8(), found))

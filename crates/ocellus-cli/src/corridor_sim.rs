@@ -88,8 +88,6 @@ pub struct StepRecord {
     pub person_bearing_next_deg: f64,
     /// Maximum surprise of the burst, bits.
     pub surprise_max: f32,
-    /// The last frame of the burst.
-    pub frame: RgbImage,
 }
 
 fn asset(name: &str) -> Result<RgbImage> {
@@ -126,8 +124,14 @@ pub fn corridor() -> Result<Corridor> {
     Ok(Corridor::new(CorridorConfig::default(), &tex)?)
 }
 
-/// Runs the experiment; returns one record per step.
-pub fn run(cfg: &RunConfig, world: &Corridor) -> Result<Vec<StepRecord>> {
+/// Runs the experiment; returns one record per step. `on_step` sees each step's record with
+/// the last frame of its burst as it happens, so that frames are written, not kept: memory
+/// per step stays at the record's size (about a kilobyte) whatever the number of steps.
+pub fn run(
+    cfg: &RunConfig,
+    world: &Corridor,
+    mut on_step: impl FnMut(&StepRecord, &RgbImage) -> Result<()>,
+) -> Result<Vec<StepRecord>> {
     let (w, h) = world.config().image_size;
     let mut sal_cfg = SaliencyConfig::ace2009();
     sal_cfg.channels.push(ChannelConfig { kind: ChannelKind::Flicker, weight: 1.0 });
@@ -190,7 +194,7 @@ pub fn run(cfg: &RunConfig, world: &Corridor) -> Result<Vec<StepRecord>> {
         let bearing_from = |x: f64| (person.y_m - truth.y).atan2(person.x_m - x).to_degrees();
         let person_bearing_deg = bearing_from(truth.x);
         let in_burst = cfg.event && k >= cfg.event_step;
-        records.push(StepRecord {
+        let record = StepRecord {
             step: k,
             true_xy: (truth.x, truth.y),
             mu: (mu.x, mu.y),
@@ -203,8 +207,9 @@ pub fn run(cfg: &RunConfig, world: &Corridor) -> Result<Vec<StepRecord>> {
             person_bearing_next_deg: bearing_from(truth.x + cfg.step_m),
             surprise_max: surprise.map().min_max().1,
             decision: decision.clone(),
-            frame: frame.context("no frame")?,
-        });
+        };
+        on_step(&record, &frame.context("no frame")?)?;
+        records.push(record);
         pan = decision.pan_deg;
     }
     Ok(records)
@@ -217,8 +222,8 @@ mod tests {
     #[test]
     fn without_event_the_gaze_serves_localization() {
         let world = corridor().unwrap();
-        let planned = run(&RunConfig::default(), &world).unwrap();
-        let forward = run(&RunConfig { fixed_forward: true, ..Default::default() }, &world).unwrap();
+        let planned = run(&RunConfig::default(), &world, |_, _| Ok(())).unwrap();
+        let forward = run(&RunConfig { fixed_forward: true, ..Default::default() }, &world, |_, _| Ok(())).unwrap();
         let angles: Vec<f64> = planned.iter().map(|r| r.decision.pan_deg).collect();
         println!("no event, chosen angles: {angles:?}");
         for r in &planned {
@@ -235,8 +240,8 @@ mod tests {
     fn the_sudden_person_turns_the_gaze() {
         let world = corridor().unwrap();
         let cfg = RunConfig { event: true, steps: 7, ..Default::default() };
-        let event = run(&cfg, &world).unwrap();
-        let calm = run(&RunConfig { steps: 7, ..Default::default() }, &world).unwrap();
+        let event = run(&cfg, &world, |_, _| Ok(())).unwrap();
+        let calm = run(&RunConfig { steps: 7, ..Default::default() }, &world, |_, _| Ok(())).unwrap();
         let k = cfg.event_step;
         let r = &event[k];
         println!(

@@ -59,7 +59,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
     let fov = dir.join("logpolar");
     std::fs::create_dir_all(&fov)?;
     for (path, (px, py)) in &peaks {
-        let img = ocellus_io::read_image(path)?.to_u8();
+        let img = crate::budget::read_image(path)?.to_u8();
         let (w, h) = img.size();
         // The saliency peak is in edge coordinates (pixel centres at +0.5); the map puts
         // pixel centres at integers.

@@ -4,7 +4,6 @@
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use ocellus_image::convert::RgbImage;
-use ocellus_io::video::Frames;
 use std::path::Path;
 
 /// Calls `f(k, frame)` for each frame (at most `limit`). If the source fails at frame k, the
@@ -14,7 +13,7 @@ pub fn for_each_frame(
     limit: Option<usize>,
     mut f: impl FnMut(usize, &RgbImage) -> Result<()>,
 ) -> Result<usize> {
-    let mut frames = Frames::open(input)?;
+    let mut frames = crate::budget::open_frames(input)?;
     let total = match (frames.len_hint(), limit) {
         (Some(n), Some(l)) => Some(n.min(l)),
         (n, l) => n.or(l),

@@ -92,6 +92,13 @@ pub fn run(a: GenerateArgs) -> Result<()> {
         ScenarioArg::Sudden => Scenario::SuddenObject,
         ScenarioArg::Pan => Scenario::Pan,
     };
+    if a.event_frame >= a.frames {
+        anyhow::bail!(
+            "--event-frame {} must be below --frames {}: the object would never appear",
+            a.event_frame,
+            a.frames
+        );
+    }
     let cfg = SceneConfig {
         frames: a.frames,
         event_frame: a.event_frame,
@@ -143,11 +150,11 @@ pub fn write_sequence(cfg: SceneConfig, out: &Path, y4m: bool) -> Result<()> {
     truth.flush()?;
     pan_tilt.flush()?;
     outln!(
-        "{} frames {}x{} ({:?}) written to {} ({}), with truth.csv and pan_tilt.csv",
+        "{} frames {}x{} ({}) written to {} ({}), with truth.csv and pan_tilt.csv",
         g.len(),
         c.width,
         c.height,
-        scenario,
+        format!("{scenario:?}").to_lowercase(),
         a.out.display(),
         if a.y4m { "sequence.y4m" } else { "frames/" }
     );

@@ -121,11 +121,11 @@ pub fn run(a: GroundArgs) -> Result<()> {
     )?;
     cam.flush()?;
     outln!(
-        "{} frames {}x{} ({:?}{}) written to {} with groundtruth.tum, encoders.csv, camera.toml",
+        "{} frames {}x{} ({}{}) written to {} with groundtruth.tum, encoders.csv, camera.toml",
         scene.len(),
         cfg.width,
         cfg.height,
-        texture,
+        format!("{texture:?}").to_lowercase(),
         if a.hard { ", hard" } else { "" },
         a.out.display()
     );

@@ -122,7 +122,7 @@ fn parse_point(s: &str) -> std::result::Result<[f64; 2], String> {
 }
 
 fn grey_f32(path: &Path) -> Result<Plane<f32>> {
-    Ok(ocellus_io::read_image(path)?.to_luma8().map(|v| v as f32))
+    Ok(crate::budget::read_image(path)?.to_luma8().map(|v| v as f32))
 }
 
 /// Runs the subcommand.
@@ -136,7 +136,7 @@ pub fn run(a: LogPolarArgs) -> Result<()> {
     if path.is_dir() || !ocellus_io::is_image_path(path) {
         return run_stream(&a, path);
     }
-    let img = ocellus_io::read_image(path)?;
+    let img = crate::budget::read_image(path)?;
     let (w, h) = img.size();
     let cfg = config(&a, w, h);
     let t = std::time::Instant::now();
@@ -305,8 +305,8 @@ fn run_register(r: &RegisterArgs) -> Result<()> {
 }
 
 fn run_vergence(v: &VergenceArgs) -> Result<()> {
-    let l = ocellus_io::read_image(&v.left)?.to_luma8();
-    let r = ocellus_io::read_image(&v.right)?.to_luma8();
+    let l = crate::budget::read_image(&v.left)?.to_luma8();
+    let r = crate::budget::read_image(&v.right)?.to_luma8();
     let opts = VergenceOptions { max_disparity: v.max_disparity, max_radius: v.radius, ..Default::default() };
     let est = vergence(&l, &r, v.gaze, &opts)?;
     if v.json {

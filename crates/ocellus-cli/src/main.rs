@@ -11,6 +11,7 @@ mod bench_geometry;
 mod bench_logpolar;
 mod bench_odometry;
 mod bench_planning;
+mod budget;
 mod calibrate_cmd;
 mod calibrate_planar;
 mod camera_file;

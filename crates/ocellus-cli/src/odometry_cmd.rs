@@ -270,7 +270,10 @@ fn eval(a: &EvalArgs) -> Result<()> {
     let dist = |p: &TumPose, q: &TumPose| (p.position[0] - q.position[0]).hypot(p.position[1] - q.position[1]);
     let path: f64 = pairs.windows(2).map(|w| dist(&w[0].1, &w[1].1)).sum();
     let (le, lg) = pairs[pairs.len() - 1];
-    let drift = if path > 0.0 { 100.0 * dist(&le, &lg) / path } else { f64::NAN };
+    if !(path > 0.0) {
+        bail!("the paired ground-truth poses do not move (path length 0): drift is undefined");
+    }
+    let drift = 100.0 * dist(&le, &lg) / path;
     let heading = wrap(le.yaw() - lg.yaw()).to_degrees().abs();
     let ate = (pairs.iter().map(|(e, g)| dist(e, g).powi(2)).sum::<f64>() / pairs.len() as f64).sqrt();
     // Relative pose error over one step, translation part, in the frame of the first pose.

@@ -44,8 +44,8 @@ struct CorridorArgs {
 
 /// Marks the landmarks (yellow rings at camera height) and the chosen direction (a vertical
 /// line: green for a top-down choice, red for bottom-up) on the step's frame.
-fn annotate(world: &Corridor, r: &StepRecord) -> Plane<[u8; 3]> {
-    let mut img = r.frame.to_u8();
+fn annotate(world: &Corridor, r: &StepRecord, frame: &ocellus_image::convert::RgbImage) -> Plane<[u8; 3]> {
+    let mut img = frame.to_u8();
     let row = (img.height() as f32 - 1.0) / 2.0;
     for (lx, ly) in world.landmarks() {
         let b = (ly - r.true_xy.1).atan2(lx - r.true_xy.0).to_degrees();
@@ -114,12 +114,12 @@ pub fn run(a: PlanArgs) -> Result<()> {
     let What::Corridor(a) = a.what;
     let world = corridor_sim::corridor()?;
     let cfg = RunConfig { steps: a.steps, event: a.event, seed: a.seed, ..RunConfig::default() };
-    let records = corridor_sim::run(&cfg, &world)?;
     let frames = a.out.join("frames");
     std::fs::create_dir_all(&frames).with_context(|| format!("cannot create {}", frames.display()))?;
-    for r in &records {
-        ocellus_io::write_png(frames.join(format!("step_{:02}.png", r.step)), &to_image_rgb8(&annotate(&world, r)))?;
-    }
+    let records = corridor_sim::run(&cfg, &world, |r, frame| {
+        let path = frames.join(format!("step_{:02}.png", r.step));
+        Ok(ocellus_io::write_png(path, &to_image_rgb8(&annotate(&world, r, frame)))?)
+    })?;
     write_csv(&a.out.join("steps.csv"), &records)?;
     // Chosen angle per step; with --event, the run without it beside.
     let mut series = vec![plot::Series {
@@ -127,8 +127,11 @@ pub fn run(a: PlanArgs) -> Result<()> {
         points: angles(&records),
         color: RGBColor(200, 40, 40),
     }];
-    let baseline =
-        if a.event { Some(corridor_sim::run(&RunConfig { event: false, ..cfg.clone() }, &world)?) } else { None };
+    let baseline = if a.event {
+        Some(corridor_sim::run(&RunConfig { event: false, ..cfg.clone() }, &world, |_, _| Ok(()))?)
+    } else {
+        None
+    };
     if let Some(b) = &baseline {
         series.push(plot::Series { label: "no event", points: angles(b), color: RGBColor(30, 90, 200) });
     }

@@ -62,7 +62,7 @@ pub fn process_one(
     out: &Path,
     conspicuity: bool,
 ) -> Result<SaliencyResult> {
-    let img = ocellus_io::read_image(path)?;
+    let img = crate::budget::read_image(path)?;
     let (w, h) = img.size();
     if engine.as_ref().map(|e| e.frame_size()) != Some((w, h)) {
         *engine = Some(SaliencyEngine::new(cfg.clone(), w, h).with_context(|| format!("{}", path.display()))?);
@@ -152,7 +152,9 @@ pub fn run(a: SaliencyArgs) -> Result<()> {
         bar.inc(1);
     }
     bar.finish_and_clear();
-    outln!("wrote maps to {}", a.out.display());
+    if failed < files.len() {
+        outln!("wrote the maps of {} images to {}", files.len() - failed, a.out.display());
+    }
     if failed > 0 {
         bail!("{failed} of {} images failed", files.len());
     }

@@ -23,8 +23,8 @@ pub struct StereoArgs {
     /// semi-global matching (census costs, 8 paths by default).
     #[arg(long, value_enum, default_value = "sgm")]
     pub method: Method,
-    /// Disparities searched: 0..N pixels. Range: 1..=1024.
-    #[arg(long, default_value_t = 64, value_parser = crate::ranges::within(1usize, 1024))]
+    /// Disparities searched: 0..N pixels. Range: 1..=256.
+    #[arg(long, default_value_t = 64, value_parser = crate::ranges::within(1usize, 256))]
     pub max_disp: usize,
     /// Odd block size of `bm`, pixels. Range: odd, 3..=63.
     #[arg(long, default_value_t = 9, value_parser = crate::ranges::within(3usize, 63))]
@@ -36,9 +36,9 @@ pub struct StereoArgs {
     /// Paths of `sgm`. Range: 4 or 8.
     #[arg(long, default_value_t = 8, value_parser = crate::ranges::within(4u8, 8))]
     pub paths: u8,
-    /// Penalties P1 and P2 of `sgm` (census bits). Range: 0..=1000 each, P1 <= P2.
+    /// Penalties P1 and P2 of `sgm` (census bits). Range: 1..=1000 each, P1 <= P2.
     #[arg(long, num_args = 2, value_names = ["P1", "P2"], default_values_t = [10u16, 120],
-          value_parser = crate::ranges::within(0u16, 1000))]
+          value_parser = crate::ranges::within(1u16, 1000))]
     pub penalties: Vec<u16>,
     /// 3x3 median of the `sgm` disparities.
     #[arg(long)]
@@ -114,7 +114,7 @@ fn write_cloud(
 
 /// Runs the subcommand.
 pub fn run(a: StereoArgs) -> Result<()> {
-    let (li, ri) = (ocellus_io::read_image(&a.left)?, ocellus_io::read_image(&a.right)?);
+    let (li, ri) = (crate::budget::read_image(&a.left)?, crate::budget::read_image(&a.right)?);
     if li.size() != ri.size() {
         bail!("the images differ in size: {:?} and {:?}", li.size(), ri.size());
     }
@@ -138,6 +138,12 @@ pub fn run(a: StereoArgs) -> Result<()> {
                 n => bail!("--paths {n}: SGM uses 4 or 8 paths"),
             };
             let [p1, p2] = [a.penalties[0], a.penalties[1]];
+            // The cost volume: a byte of census cost and two of aggregated cost per pixel and disparity.
+            let need = (l.width() * l.height()) as u64 * (3 * a.max_disp as u64 + 16);
+            crate::budget::check(
+                &format!("SGM at {}x{} with {} disparities", l.width(), l.height(), a.max_disp),
+                need,
+            )?;
             let p = Sgm {
                 max_disparity: a.max_disp,
                 paths,

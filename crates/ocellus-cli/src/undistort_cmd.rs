@@ -37,7 +37,7 @@ pub fn run(a: UndistortArgs) -> Result<()> {
     // Remap tables for the current image size.
     let mut maps: Option<RemapTables> = None;
     for (f, name) in files.iter().zip(&stems) {
-        let img = ocellus_io::read_image(f).with_context(|| format!("cannot read {}", f.display()))?.to_u8();
+        let img = crate::budget::read_image(f).with_context(|| format!("cannot read {}", f.display()))?.to_u8();
         let size = img.size();
         camera_file::check_frame_size(&cam, &a.camera, &f.display().to_string(), size)?;
         if maps.as_ref().map(|m| m.0) != Some(size) {

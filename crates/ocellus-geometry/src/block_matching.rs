@@ -102,12 +102,11 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, top: 
             right.height()
         )));
     }
-    if p.block % 2 == 0 || p.block < 3 || p.max_disparity == 0 || !p.uniqueness.is_finite() || p.uniqueness < 0.0 {
-        return Err(GeometryError::Invalid(format!("block matching {p:?}: odd block >= 3, max_disparity >= 1")));
+    if p.block % 2 == 0 || p.block < 3 {
+        return Err(GeometryError::Invalid(format!("block size {} must be odd and at least 3", p.block)));
     }
-    if p.max_disparity > 256 {
-        return Err(GeometryError::Invalid(format!("max_disparity {} must be at most 256", p.max_disparity)));
-    }
+    ocellus_image::check::within("max_disparity", p.max_disparity, 1, 256).map_err(GeometryError::Invalid)?;
+    ocellus_image::check::within("uniqueness", p.uniqueness, 0.0, 0.99).map_err(GeometryError::Invalid)?;
     let (w, h) = left.size();
     if w < p.block || h < p.block {
         return Err(GeometryError::Invalid(format!("image {w}x{h} smaller than the {0}x{0} block", p.block)));

@@ -88,9 +88,8 @@ impl Sgm {
                 right.height()
             )));
         }
-        if !(1..=256).contains(&self.max_disparity) {
-            return Err(GeometryError::Invalid(format!("max_disparity {} must be 1..=256", self.max_disparity)));
-        }
+        ocellus_image::check::within("max_disparity", self.max_disparity, 1, 256).map_err(GeometryError::Invalid)?;
+        ocellus_image::check::within("uniqueness", self.uniqueness, 0.0, 0.99).map_err(GeometryError::Invalid)?;
         let (cw, ch) = (self.census_width, self.census_height);
         if cw % 2 == 0 || ch % 2 == 0 || cw * ch - 1 > 63 || cw * ch < 9 {
             return Err(GeometryError::Invalid(format!(

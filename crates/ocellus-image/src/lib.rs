@@ -15,6 +15,7 @@
 //! assert_eq!((half.width(), half.height()), (32, 24));
 //! ```
 
+pub mod check;
 pub mod convert;
 mod error;
 pub mod filter;

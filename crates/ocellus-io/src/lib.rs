@@ -84,6 +84,19 @@ pub enum IoError {
     /// The ffmpeg program is missing or failed to start.
     #[error("{0}")]
     Ffmpeg(String),
+    /// The image is larger than the caller's pixel limit (checked from the header, before
+    /// any pixel is decoded).
+    #[error("{path}: {width}x{height} is {:.1} megapixels, over the limit of {:.1} megapixels", (*width * *height) as f64 / 1e6, *max_pixels as f64 / 1e6)]
+    TooLarge {
+        /// The path.
+        path: PathBuf,
+        /// Width in pixels.
+        width: u64,
+        /// Height in pixels.
+        height: u64,
+        /// The limit, pixels.
+        max_pixels: u64,
+    },
     /// The content is valid but unusable (zero size, wrong shape, ...).
     #[error("{path}: {reason}")]
     Invalid {
@@ -129,15 +142,34 @@ pub fn is_image_path(path: &Path) -> bool {
         .is_some_and(|e| IMAGE_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
 }
 
-/// Reads an image file (format from its content, not its name) as RGB.
+/// Largest image [`read_image`] decodes, pixels (width x height): 100 megapixels. Callers
+/// with a memory budget pass their own limit to [`read_image_within`].
+pub const DEFAULT_MAX_PIXELS: u64 = 100_000_000;
+
+/// Reads an image file (format from its content, not its name) as RGB, up to
+/// [`DEFAULT_MAX_PIXELS`].
 pub fn read_image(path: impl AsRef<Path>) -> Result<RgbImage> {
-    let path = path.as_ref();
-    let bytes = read_bytes(path)?;
-    decode_image(&bytes, path)
+    read_image_within(path, DEFAULT_MAX_PIXELS)
 }
 
-/// Decodes image bytes; `path` is only used in error messages.
+/// Reads an image file of at most `max_pixels` pixels; a larger one is refused from its
+/// header, before anything is allocated for it ([`IoError::TooLarge`]).
+pub fn read_image_within(path: impl AsRef<Path>, max_pixels: u64) -> Result<RgbImage> {
+    let path = path.as_ref();
+    let bytes = read_bytes(path)?;
+    decode_image_within(&bytes, path, max_pixels)
+}
+
+/// Decodes image bytes, up to [`DEFAULT_MAX_PIXELS`]; `path` is only used in error messages.
 pub fn decode_image(bytes: &[u8], path: &Path) -> Result<RgbImage> {
+    decode_image_within(bytes, path, DEFAULT_MAX_PIXELS)
+}
+
+/// Decodes image bytes of at most `max_pixels` pixels.
+///
+/// A JPEG without its end-of-image marker is refused as truncated: the decoder would fill the
+/// missing rows with grey and say nothing.
+pub fn decode_image_within(bytes: &[u8], path: &Path, max_pixels: u64) -> Result<RgbImage> {
     if bytes.is_empty() {
         return Err(IoError::EmptyFile { path: path.into() });
     }
@@ -145,9 +177,30 @@ pub fn decode_image(bytes: &[u8], path: &Path) -> Result<RgbImage> {
     if !matches!(format, image::ImageFormat::Png | image::ImageFormat::Jpeg | image::ImageFormat::Pnm) {
         return Err(IoError::Unsupported { path: path.into() });
     }
-    let img = image::load_from_memory_with_format(bytes, format)
-        .map_err(|e| IoError::Corrupt { path: path.into(), reason: e.to_string() })?;
+    let corrupt = |reason: String| IoError::Corrupt { path: path.into(), reason };
+    if format == image::ImageFormat::Jpeg && !has_jpeg_end(bytes) {
+        return Err(corrupt("truncated JPEG: the end-of-image marker is missing".into()));
+    }
+    let reader = || image::ImageReader::with_format(std::io::Cursor::new(bytes), format);
+    let (w, h) = reader().into_dimensions().map_err(|e| corrupt(e.to_string()))?;
+    if w as u64 * h as u64 > max_pixels {
+        return Err(IoError::TooLarge { path: path.into(), width: w.into(), height: h.into(), max_pixels });
+    }
+    let mut limits = image::Limits::default();
+    // The size is checked above; the decoder may use up to 16-bit RGBA for it.
+    limits.max_alloc = Some((w as u64 * h as u64).saturating_mul(8).max(1 << 26));
+    let mut r = reader();
+    r.limits(limits);
+    let img = r.decode().map_err(|e| corrupt(e.to_string()))?;
     from_dynamic(&img).map_err(|e| IoError::Invalid { path: path.into(), reason: e.to_string() })
+}
+
+/// Whether JPEG data ends with its EOI marker (0xFFD9), allowing the zero or 0xFF padding
+/// some encoders append.
+fn has_jpeg_end(bytes: &[u8]) -> bool {
+    let end = bytes.iter().rposition(|&b| b != 0 && b != 0xff).map_or(0, |i| i + 1);
+    end >= 2 && bytes[end - 1] == 0xd9 && bytes[end - 2] == 0xff
+        || bytes[..end].windows(2).rev().take(64).any(|w| w == [0xff, 0xd9])
 }
 
 /// Writes an `image` buffer as PNG.

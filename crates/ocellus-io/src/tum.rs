@@ -42,6 +42,22 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Vec<TumPose>> {
             reason: "no poses (lines 'timestamp tx ty tz qx qy qz qw')".into(),
         });
     }
+    // Evaluation pairs poses by time: a repeated or backward timestamp would silently drop
+    // poses (and score what is left), so the order is part of the format here.
+    for (i, w) in rows.windows(2).enumerate() {
+        if w[1][0] <= w[0][0] {
+            return Err(IoError::Invalid {
+                path: path.into(),
+                reason: format!(
+                    "pose {}: timestamp {} does not increase (pose {} has {}); timestamps must be strictly increasing",
+                    i + 2,
+                    w[1][0],
+                    i + 1,
+                    w[0][0]
+                ),
+            });
+        }
+    }
     rows.iter()
         .enumerate()
         .map(|(i, r)| {
@@ -96,5 +112,9 @@ mod tests {
         assert!((TumPose::planar(0.0, 0.0, 0.0, 3.0).yaw() - 3.0).abs() < 1e-12);
         assert!(parse(b"0 0 0 0 0 0 0 0\n", Path::new("x")).is_err());
         assert!(parse(b"0 1 2 3 0 0 0\n", Path::new("x")).is_err());
+        // Repeated and backward timestamps are refused, naming the pose.
+        let e = parse(b"0 0 0 0 0 0 0 1\n0.1 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n", Path::new("x")).unwrap_err();
+        assert!(e.to_string().contains("pose 3"), "{e}");
+        assert!(parse(b"1 0 0 0 0 0 0 1\n0.5 0 0 0 0 0 0 1\n", Path::new("x")).is_err());
     }
 }

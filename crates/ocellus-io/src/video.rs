@@ -6,7 +6,7 @@
 //! frames); nothing links to libav. All frames of a source must have the same size.
 
 use crate::y4m::Y4mReader;
-use crate::{read_image, IoError, Result};
+use crate::{read_image_within, IoError, Result, DEFAULT_MAX_PIXELS};
 use ocellus_image::convert::RgbImage;
 use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
@@ -118,6 +118,7 @@ pub struct Frames {
     size: Option<(usize, usize)>,
     index: usize,
     done: bool,
+    max_pixels: u64,
 }
 
 fn ffmpeg_missing(program: &str, e: std::io::Error) -> IoError {
@@ -219,8 +220,15 @@ impl Ffmpeg {
 }
 
 impl Frames {
-    /// Opens a folder of images (natural order), a `.y4m` file, or any other file through ffmpeg.
+    /// Opens a folder of images (natural order), a `.y4m` file, or any other file through
+    /// ffmpeg, with frames of up to [`DEFAULT_MAX_PIXELS`].
     pub fn open(path: impl AsRef<Path>) -> Result<Frames> {
+        Self::open_within(path, DEFAULT_MAX_PIXELS)
+    }
+
+    /// [`Frames::open`] for frames of at most `max_pixels` pixels: a larger video is refused
+    /// from its header, a larger image of a folder when it is reached.
+    pub fn open_within(path: impl AsRef<Path>, max_pixels: u64) -> Result<Frames> {
         let path = path.as_ref();
         if !path.exists() {
             return Err(IoError::NotFound { path: path.into() });
@@ -247,7 +255,12 @@ impl Frames {
             let (w, h, n) = probe(path)?;
             (Kind::Ffmpeg(Box::new(Ffmpeg::start(path, w, h)?)), n, Some((w, h)))
         };
-        Ok(Frames { path: path.into(), kind, len, size, index: 0, done: false })
+        if let Some((w, h)) = size {
+            if w as u64 * h as u64 > max_pixels {
+                return Err(IoError::TooLarge { path: path.into(), width: w as u64, height: h as u64, max_pixels });
+            }
+        }
+        Ok(Frames { path: path.into(), kind, len, size, index: 0, done: false, max_pixels })
     }
 
     /// Number of frames when known in advance (folders, Y4M, and containers that store it).
@@ -273,7 +286,7 @@ impl Frames {
         let k = self.index;
         let r = match &mut self.kind {
             Kind::Folder(files) => match files.get(k) {
-                Some(f) => read_image(f).map(Some).map_err(|e| IoError::Video {
+                Some(f) => read_image_within(f, self.max_pixels).map(Some).map_err(|e| IoError::Video {
                     path: self.path.clone(),
                     frame: k,
                     reason: e.to_string(),
@@ -282,6 +295,14 @@ impl Frames {
             },
             Kind::Y4m(r) => r.next_frame(),
             Kind::Ffmpeg(f) => f.next(&self.path, k),
+        };
+        // A source that ends before its first frame (a Y4M of only a header, an empty video) is
+        // an error, not an empty success.
+        let r = match r {
+            Ok(None) if k == 0 => {
+                Err(IoError::Invalid { path: self.path.clone(), reason: "contains no frames".into() })
+            }
+            r => r,
         };
         let r = r.and_then(|f| match (f, self.size) {
             (Some(img), Some(s)) if img.size() != s => Err(IoError::Video {

@@ -119,7 +119,10 @@ fn parse_header(line: &[u8], path: &Path) -> Result<Y4mHeader> {
         }
     }
     if h.width == 0 || h.height == 0 || h.width > 1 << 15 || h.height > 1 << 15 || h.width * h.height > 1 << 26 {
-        return Err(IoError::Invalid { path: path.into(), reason: format!("frame size {}x{}", h.width, h.height) });
+        return Err(IoError::Invalid {
+            path: path.into(),
+            reason: format!("frame size {}x{} is outside 1..=32768 per side and 67 megapixels", h.width, h.height),
+        });
     }
     Ok(h)
 }

@@ -75,23 +75,18 @@ impl OdometryConfig {
     }
 
     fn check(&self) -> Result<()> {
-        let ok = self.height_m > 0.0
-            && self.focal_px > 0.0
-            && self.height_m.is_finite()
-            && self.focal_px.is_finite()
-            && self.flow_sigma_px > 0.0
-            && self.flow_sigma_px.is_finite()
-            && self.process_sigma.iter().all(|s| *s > 0.0 && s.is_finite())
-            && self.mount.right_m.is_finite()
-            && self.mount.forward_m.is_finite();
-        if ok {
-            Ok(())
-        } else {
-            Err(OdometryError::Invalid(format!(
-                "height {} m, focal {} px, flow sigma {} px, process sigma {:?}, mount {:?}: all finite and positive",
-                self.height_m, self.focal_px, self.flow_sigma_px, self.process_sigma, self.mount
-            )))
-        }
+        use ocellus_image::check;
+        (|| {
+            check::positive("camera height_m", self.height_m)?;
+            check::positive("focal_px", self.focal_px)?;
+            check::positive("flow_sigma_px", self.flow_sigma_px)?;
+            for (k, s) in self.process_sigma.iter().enumerate() {
+                check::positive(&format!("process_sigma[{k}]"), *s)?;
+            }
+            check::finite("mount right_m", self.mount.right_m)?;
+            check::finite("mount forward_m", self.mount.forward_m)
+        })()
+        .map_err(OdometryError::Invalid)
     }
 }
 

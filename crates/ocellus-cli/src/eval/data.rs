@@ -50,7 +50,7 @@ fn find_points(dir: &Path, stem: &str) -> Option<PathBuf> {
 
 /// An image as grey values in [0, 1] (mean of R, G, B).
 pub fn grey(path: &Path) -> Result<Plane<f32>> {
-    let img = ocellus_io::read_image(path)?;
+    let img = crate::budget::read_image(path)?;
     let (w, h) = img.size();
     Ok(Plane::from_fn(w, h, |x, y| {
         let c = img.get_f32(x, y);
@@ -113,7 +113,7 @@ fn load_sample(item: &Item, model: &Model, engine: &mut Option<ocellus_attention
             let pts = ocellus_io::points::read_points(p)?;
             let (w, h) = match size {
                 Some(s) => s,
-                None => ocellus_io::read_image(&item.stimulus)?.size(),
+                None => crate::budget::read_image(&item.stimulus)?.size(),
             };
             size = Some((w, h));
             fixations = Some(ocellus_io::points::to_pixels(&pts, w, h));

@@ -146,7 +146,7 @@ pub(crate) fn model_map(model: &Model, item: &Item, engine: &mut Option<Saliency
             Ok(Some(data::grey(&p)?))
         }
         Model::Ocellus(cfg) => {
-            let img = ocellus_io::read_image(&item.stimulus)?;
+            let img = crate::budget::read_image(&item.stimulus)?;
             let (w, h) = img.size();
             if engine.as_ref().map(|e| e.frame_size()) != Some((w, h)) {
                 *engine = Some(SaliencyEngine::new((**cfg).clone(), w, h)?);

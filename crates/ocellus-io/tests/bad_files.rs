@@ -1,0 +1,54 @@
+//! Files a careless or hostile user may give: each is refused with a clear error, before any
+//! large allocation, never decoded into a silently wrong image.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use ocellus_io::{decode_image, decode_image_within, video::Frames, IoError};
+use std::path::Path;
+
+#[test]
+fn a_truncated_jpeg_is_refused() {
+    let bytes = std::fs::read(ocellus_testdata::data_file("rocket.jpg")).unwrap();
+    assert!(decode_image(&bytes, Path::new("rocket.jpg")).is_ok());
+    for keep in [bytes.len() - 2, bytes.len() / 2, bytes.len() - 1000] {
+        let e = decode_image(&bytes[..keep], Path::new("cut.jpg")).unwrap_err();
+        assert!(e.to_string().contains("truncated JPEG"), "{keep}: {e}");
+    }
+    // Padding after the end marker is allowed.
+    let mut padded = bytes.clone();
+    padded.extend([0u8; 16]);
+    assert!(decode_image(&padded, Path::new("padded.jpg")).is_ok());
+}
+
+#[test]
+fn an_image_over_the_pixel_limit_is_refused_from_its_header() {
+    // A PGM header claiming 20000x20000 pixels with almost no data: refused by size, not
+    // by running out of memory or data.
+    let mut pgm = b"P5\n20000 20000\n255\n".to_vec();
+    pgm.extend([0u8; 64]);
+    match decode_image(&pgm, Path::new("huge.pgm")) {
+        Err(IoError::TooLarge { width: 20000, height: 20000, max_pixels, .. }) => {
+            assert_eq!(max_pixels, ocellus_io::DEFAULT_MAX_PIXELS)
+        }
+        other => panic!("{other:?}"),
+    }
+    let small = b"P5\n4 2\n255\n\x00\x01\x02\x03\x04\x05\x06\x07";
+    assert!(decode_image_within(small, Path::new("s.pgm"), 8).is_ok());
+    let e = decode_image_within(small, Path::new("s.pgm"), 7).unwrap_err();
+    assert!(e.to_string().contains("over the limit"), "{e}");
+}
+
+#[test]
+fn a_y4m_without_frames_is_an_error() {
+    let dir = std::env::temp_dir().join(format!("ocellus-badfiles-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("header.y4m");
+    std::fs::write(&p, b"YUV4MPEG2 W64 H48 F30:1 Ip A1:1 C444\n").unwrap();
+    let mut f = Frames::open(&p).unwrap();
+    let e = f.next_frame().unwrap_err();
+    assert!(e.to_string().contains("no frames"), "{e}");
+    // A Y4M header too large for the limit is refused on opening.
+    let q = dir.join("big.y4m");
+    std::fs::write(&q, b"YUV4MPEG2 W8000 H8000 F30:1 Ip A1:1 C444\n").unwrap();
+    assert!(matches!(Frames::open_within(&q, 1_000_000), Err(IoError::TooLarge { .. })));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
