@@ -95,10 +95,10 @@ fn create(dir: &Path, name: &str) -> Result<std::io::BufWriter<std::fs::File>> {
 
 impl Outputs {
     fn new(dir: &Path, overlays: bool) -> Result<Self> {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        crate::output_files::create_dir(&dir)?;
         ocellus_io::video_writer::check_output(&dir.join("overlays.mp4"))?;
         if overlays {
-            std::fs::create_dir_all(dir.join("overlays"))?;
+            crate::output_files::create_dir(&dir.join("overlays"))?;
         }
         let mut scanpath = create(dir, "scanpath.csv")?;
         writeln!(scanpath, "frame,x,y,azimuth_deg,elevation_deg,reason")?;

@@ -118,7 +118,7 @@ pub fn run(json_out: bool, n: usize) -> Result<()> {
     let frames: Vec<RgbImage> = (0..SEQUENCE).map(|k| g.frame(k).map(|f| f.0)).collect::<Result<_, _>>()?;
     let temporal = temporal_costs(&frames, n)?;
     let dir = std::env::temp_dir().join(format!("ocellus-bench-attention-{}", std::process::id()));
-    std::fs::create_dir_all(&dir)?;
+    crate::output_files::create_dir(&dir)?;
     let y4m = dir.join("sequence.y4m");
     let mut w = Y4mWriter::new(std::io::BufWriter::new(std::fs::File::create(&y4m)?), 640, 480, (30, 1))?;
     frames.iter().try_for_each(|f| w.write_frame(f))?;

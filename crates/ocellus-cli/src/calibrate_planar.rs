@@ -131,7 +131,7 @@ pub fn run_chessboard(a: ChessboardArgs) -> Result<()> {
     output_stems(&files)?;
     check_out_dir(&a.out, &files)?;
     check_out_dir(&a.out.join("corners"), &files)?;
-    std::fs::create_dir_all(a.out.join("corners")).with_context(|| format!("cannot create {}", a.out.display()))?;
+    crate::output_files::create_dir(&a.out.join("corners"))?;
     let object: Vec<[f64; 2]> =
         (0..rows).flat_map(|r| (0..cols).map(move |c| [c as f64 * square, r as f64 * square])).collect();
     let detections: Vec<Result<Detection>> = files
@@ -210,7 +210,7 @@ pub fn run_planar(a: PlanarArgs) -> Result<()> {
         views[i].object.push([r[1], r[2]]);
         views[i].image.push([r[3], r[4]]);
     }
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    crate::output_files::create_dir(&a.out)?;
     let cal = calibrate(&views, &a.model.options())?;
     let names: Vec<String> = ids.iter().map(|i| format!("view {i}")).collect();
     report(&a.out, &cal, size, &names, "planar_points", f64::NAN)

@@ -21,15 +21,15 @@ pub struct DemoArgs {
 /// images fixating each image's most salient point, then attention over a generated sequence.
 pub fn run(a: DemoArgs) -> Result<()> {
     let dir = a.out;
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    crate::output_files::create_dir(&dir)?;
     let src = dir.join("inputs");
-    std::fs::create_dir_all(&src)?;
+    crate::output_files::create_dir(&src)?;
     outln!("ocellus demo: bottom-up saliency (Itti-Koch-Niebur) on {} built-in images", assets::IMAGES.len());
     let mut peaks = Vec::new();
     for preset in SaliencyConfig::PRESETS {
         let cfg = SaliencyConfig::preset(preset)?;
         let out = dir.join(preset);
-        std::fs::create_dir_all(&out)?;
+        crate::output_files::create_dir(&out)?;
         let mut engine = None;
         for (name, bytes) in assets::IMAGES {
             let path = src.join(name);
@@ -57,7 +57,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
     // point (where to look, then look there).
     outln!("ocellus demo: log-polar images fixating the most salient point of each image");
     let fov = dir.join("logpolar");
-    std::fs::create_dir_all(&fov)?;
+    crate::output_files::create_dir(&fov)?;
     for (path, (px, py)) in &peaks {
         let img = crate::budget::read_image(path)?.to_u8();
         let (w, h) = img.size();

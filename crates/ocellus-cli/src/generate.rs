@@ -115,7 +115,7 @@ pub fn write_sequence(cfg: SceneConfig, out: &Path, y4m: bool) -> Result<()> {
     let scenario = cfg.scenario;
     let g = scene(cfg)?;
     let a = Out { out: out.to_path_buf(), y4m };
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    crate::output_files::create_dir(&a.out)?;
     let create = |name: &str| -> Result<std::io::BufWriter<std::fs::File>> {
         let p = a.out.join(name);
         Ok(std::io::BufWriter::new(
@@ -130,7 +130,7 @@ pub fn write_sequence(cfg: SceneConfig, out: &Path, y4m: bool) -> Result<()> {
     let mut y4m = if a.y4m { Some(Y4mWriter::new(create("sequence.y4m")?, c.width, c.height, (30, 1))?) } else { None };
     let frames_dir = a.out.join("frames");
     if !a.y4m {
-        std::fs::create_dir_all(&frames_dir)?;
+        crate::output_files::create_dir(&frames_dir)?;
     }
     for k in 0..g.len() {
         let (frame, t) = g.frame(k)?;

@@ -67,7 +67,7 @@ pub fn run(a: ChessboardArgs) -> Result<()> {
     let bytes = assets::IMAGES.iter().find(|(n, _)| *n == "coffee.png").map(|(_, b)| *b).context("missing asset")?;
     let photo = ocellus_io::decode_image(bytes, Path::new("coffee.png"))?.to_luma8().map(|v| v as f32 / 255.0);
     let background = resize(&photo, w, h, ResampleMethod::Bilinear)?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    crate::output_files::create_dir(&a.out)?;
     camera_file::write(&a.out.join("camera_truth.toml"), &truth)?;
     let csv_path = a.out.join("corners_truth.csv");
     let mut csv = std::io::BufWriter::new(

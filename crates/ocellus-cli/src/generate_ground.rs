@@ -71,7 +71,7 @@ pub fn run(a: GroundArgs) -> Result<()> {
     let base = if a.hard { GroundConfig::hard(texture, a.seed) } else { GroundConfig::easy(texture, a.seed) };
     let cfg = GroundConfig { frames: a.frames, ..base };
     let scene = GroundScene::new(cfg, textures()?)?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    crate::output_files::create_dir(&a.out)?;
     let create = |name: &str| -> Result<std::io::BufWriter<std::fs::File>> {
         let p = a.out.join(name);
         Ok(std::io::BufWriter::new(
@@ -81,7 +81,7 @@ pub fn run(a: GroundArgs) -> Result<()> {
     let mut y4m =
         if a.y4m { Some(Y4mWriter::new(create("sequence.y4m")?, cfg.width, cfg.height, (200, 1))?) } else { None };
     if !a.y4m {
-        std::fs::create_dir_all(a.out.join("frames"))?;
+        crate::output_files::create_dir(&a.out.join("frames"))?;
     }
     let mut truth = Vec::with_capacity(scene.len());
     for k in 0..scene.len() {

@@ -4,7 +4,7 @@
 
 use crate::frames::for_each_frame;
 use crate::ranges;
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use ocellus_fovea::logpolar::{Fields, LogPolarConfig, LogPolarMap, Scratch};
 use ocellus_fovea::register::{register, Mode, RegisterOptions};
@@ -143,7 +143,7 @@ pub fn run(a: LogPolarArgs) -> Result<()> {
     let map = LogPolarMap::new(&cfg, w, h)?;
     let build_ms = t.elapsed().as_secs_f64() * 1e3;
     crate::inputs::check_out_dir(&a.out, std::slice::from_ref(path))?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    crate::output_files::create_dir(&a.out)?;
     let t = std::time::Instant::now();
     write_foveated(&map, &img.to_u8(), &a.out.join("cortex.png"), &a.out.join("inverse.png"))?;
     let sample_us = t.elapsed().as_secs_f64() * 1e6;
@@ -205,7 +205,7 @@ fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
     for d in [&a.out, &cortex_dir] {
         crate::inputs::check_out_dir(d, &[input.to_path_buf()])?;
     }
-    std::fs::create_dir_all(&cortex_dir).with_context(|| format!("cannot create {}", cortex_dir.display()))?;
+    crate::output_files::create_dir(&cortex_dir)?;
     for v in ["cortex.mp4", "inverse.mp4"] {
         ocellus_io::video_writer::check_output(&a.out.join(v))?;
     }

@@ -26,6 +26,7 @@ mod generate_ground;
 mod inputs;
 mod logpolar_cmd;
 mod odometry_cmd;
+mod output_files;
 mod overlay;
 mod plan_cmd;
 mod plot;

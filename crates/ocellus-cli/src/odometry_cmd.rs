@@ -128,7 +128,7 @@ pub fn run(a: OdometryArgs) -> Result<()> {
     let mut fusion = Fusion::new(FusionConfig { encoder_rate_hz: a.encoder_rate_hz, ..Default::default() }, mount);
     let mut vision_poses = Vec::new();
     crate::inputs::check_out_dir(&a.out, &[input.clone()])?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    crate::output_files::create_dir(&a.out)?;
     let d = cam.distortion;
     let distorted = [d.k1, d.k2, d.k3, d.p1, d.p2].iter().any(|v| *v != 0.0);
     let mut maps: Option<(Plane<f32>, Plane<f32>)> = None;

@@ -115,7 +115,7 @@ pub fn run(a: PlanArgs) -> Result<()> {
     let world = corridor_sim::corridor()?;
     let cfg = RunConfig { steps: a.steps, event: a.event, seed: a.seed, ..RunConfig::default() };
     let frames = a.out.join("frames");
-    std::fs::create_dir_all(&frames).with_context(|| format!("cannot create {}", frames.display()))?;
+    crate::output_files::create_dir(&frames)?;
     let records = corridor_sim::run(&cfg, &world, |r, frame| {
         let path = frames.join(format!("step_{:02}.png", r.step));
         Ok(ocellus_io::write_png(path, &to_image_rgb8(&annotate(&world, r, frame)))?)

@@ -108,7 +108,7 @@ pub fn run(a: SaliencyArgs) -> Result<()> {
     let files = inputs::collect_images(&a.images)?;
     inputs::output_stems(&files)?;
     inputs::check_out_dir(&a.out, &files)?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create output folder {}", a.out.display()))?;
+    crate::output_files::create_dir(&a.out)?;
     let bar = if files.len() > 1 {
         let b = ProgressBar::new(files.len() as u64);
         b.set_style(

@@ -2,7 +2,7 @@
 //! point cloud.
 
 use crate::overlay;
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use ocellus_geometry::block_matching::{bad_pixels, block_match, BlockMatching};
 use ocellus_geometry::sgm::{Sgm, SgmMatcher, SgmPaths};
@@ -26,19 +26,19 @@ pub struct StereoArgs {
     /// Disparities searched: 0..N pixels. Range: 1..=256.
     #[arg(long, default_value_t = 64, value_parser = crate::ranges::within(1usize, 256))]
     pub max_disp: usize,
-    /// Odd block size of `bm`, pixels. Range: odd, 3..=63.
-    #[arg(long, default_value_t = 9, value_parser = crate::ranges::within(3usize, 63))]
-    pub block: usize,
+    /// Odd block size of `bm`, pixels [default: 9]. Range: odd, 3..=63.
+    #[arg(long, value_parser = crate::ranges::within(3usize, 63))]
+    pub block: Option<usize>,
     /// Uniqueness margin (default 0.15 for bm, 0.05 for sgm: the best cost must beat every
     /// non-adjacent disparity by this fraction). Range: 0..=0.99.
     #[arg(long, value_parser = crate::ranges::within(0.0f32, 0.99))]
     pub uniqueness: Option<f32>,
-    /// Paths of `sgm`. Range: 4 or 8.
-    #[arg(long, default_value_t = 8, value_parser = crate::ranges::within(4u8, 8))]
-    pub paths: u8,
-    /// Penalties P1 and P2 of `sgm` (census bits). Range: 1..=1000 each, P1 <= P2.
-    #[arg(long, num_args = 2, value_names = ["P1", "P2"], default_values_t = [10u16, 120],
-          value_parser = crate::ranges::within(1u16, 1000))]
+    /// Paths of `sgm` [default: 8]. Range: 4 or 8.
+    #[arg(long, value_parser = crate::ranges::within(4u8, 8))]
+    pub paths: Option<u8>,
+    /// Penalties P1 and P2 of `sgm` (census bits) [default: 10 120]. Range: 1..=1000 each,
+    /// P1 <= P2.
+    #[arg(long, num_args = 2, value_names = ["P1", "P2"], value_parser = crate::ranges::within(1u16, 1000))]
     pub penalties: Vec<u16>,
     /// 3x3 median of the `sgm` disparities.
     #[arg(long)]
@@ -119,25 +119,43 @@ pub fn run(a: StereoArgs) -> Result<()> {
         bail!("the images differ in size: {:?} and {:?}", li.size(), ri.size());
     }
     let (l, r) = (li.to_luma8(), ri.to_luma8());
+    let sgm_only = [("--paths", a.paths.is_some()), ("--penalties", !a.penalties.is_empty()), ("--median", a.median)];
+    match a.method {
+        Method::Bm => {
+            if let Some((flag, _)) = sgm_only.iter().find(|f| f.1) {
+                bail!("{flag} is an option of --method sgm; block matching does not use it");
+            }
+        }
+        Method::Sgm if a.block.is_some() => bail!("--block is an option of --method bm; SGM does not use it"),
+        Method::Sgm => {}
+    }
+    let block = a.block.unwrap_or(9);
     let (disp, ms, what) = match a.method {
         Method::Bm => {
             let p = BlockMatching {
                 max_disparity: a.max_disp,
-                block: a.block,
+                block,
                 uniqueness: a.uniqueness.unwrap_or(0.15),
                 ..BlockMatching::default()
             };
             let t = Instant::now();
             let disp = block_match(&l, &r, &p)?;
-            (disp, t.elapsed().as_secs_f64() * 1e3, format!("block matching (block {})", a.block))
+            (disp, t.elapsed().as_secs_f64() * 1e3, format!("block matching (block {block})"))
         }
         Method::Sgm => {
-            let paths = match a.paths {
+            let n_paths = a.paths.unwrap_or(8);
+            let paths = match n_paths {
                 8 => SgmPaths::Eight,
                 4 => SgmPaths::Four,
                 n => bail!("--paths {n}: SGM uses 4 or 8 paths"),
             };
-            let [p1, p2] = [a.penalties[0], a.penalties[1]];
+            let [p1, p2] = match a.penalties[..] {
+                [p1, p2] => [p1, p2],
+                _ => [10, 120],
+            };
+            if p1 > p2 {
+                bail!("--penalties {p1} {p2}: P1 must not exceed P2");
+            }
             // The cost volume: a byte of census cost and two of aggregated cost per pixel and disparity.
             let need = (l.width() * l.height()) as u64 * (3 * a.max_disp as u64 + 16);
             crate::budget::check(
@@ -156,10 +174,10 @@ pub fn run(a: StereoArgs) -> Result<()> {
             let mut m = SgmMatcher::new(p, l.width(), l.height())?;
             let t = Instant::now();
             let disp = m.compute(&l, &r)?.clone();
-            (disp, t.elapsed().as_secs_f64() * 1e3, format!("SGM ({} paths, P1 {p1}, P2 {p2})", a.paths))
+            (disp, t.elapsed().as_secs_f64() * 1e3, format!("SGM ({n_paths} paths, P1 {p1}, P2 {p2})"))
         }
     };
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    crate::output_files::create_dir(&a.out)?;
     ocellus_io::write_png(a.out.join("disparity.png"), &to_image_rgb8(&disparity_image(&disp, a.max_disp as f32)))?;
     ocellus_io::pfm::write(a.out.join("disparity.pfm"), &disp)?;
     let valid = disp.to_vec().iter().filter(|v| v.is_finite()).count();

@@ -34,7 +34,7 @@ pub fn run(a: SurpriseArgs) -> Result<()> {
     for d in [&a.out, &maps] {
         crate::inputs::check_out_dir(d, std::slice::from_ref(&a.input))?;
     }
-    std::fs::create_dir_all(&maps).with_context(|| format!("cannot create {}", maps.display()))?;
+    crate::output_files::create_dir(&maps)?;
     let csv_path = a.out.join("surprise.csv");
     let mut csv = std::io::BufWriter::new(
         std::fs::File::create(&csv_path).with_context(|| format!("cannot create {}", csv_path.display()))?,

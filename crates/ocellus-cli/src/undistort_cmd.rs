@@ -33,7 +33,7 @@ pub fn run(a: UndistortArgs) -> Result<()> {
     let files = collect_images(&a.images)?;
     let stems = output_stems(&files)?;
     check_out_dir(&a.out, &files)?;
-    std::fs::create_dir_all(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?;
+    crate::output_files::create_dir(&a.out)?;
     // Remap tables for the current image size.
     let mut maps: Option<RemapTables> = None;
     for (f, name) in files.iter().zip(&stems) {
