@@ -95,7 +95,7 @@ fn create(dir: &Path, name: &str) -> Result<std::io::BufWriter<std::fs::File>> {
 
 impl Outputs {
     fn new(dir: &Path, overlays: bool) -> Result<Self> {
-        crate::output_files::create_dir(&dir)?;
+        crate::output_files::create_dir(dir)?;
         ocellus_io::video_writer::check_output(&dir.join("overlays.mp4"))?;
         if overlays {
             crate::output_files::create_dir(&dir.join("overlays"))?;

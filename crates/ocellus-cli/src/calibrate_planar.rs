@@ -1,12 +1,12 @@
 //! `ocellus calibrate chessboard` and `ocellus calibrate planar`: Zhang calibration from
 //! images of a chessboard or from given planar correspondences.
 
-use crate::camera_file::{self, CameraFile};
 use crate::inputs::{check_out_dir, collect_images, output_stems, stem};
 use crate::overlay::draw_ring;
 use crate::plot::{self, Plot, Series};
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use ocellus_geometry::camera_file::{self, CameraFile};
 use ocellus_geometry::chessboard::{find_chessboard, ChessboardOptions};
 use ocellus_geometry::zhang::{calibrate, project_view, PlanarCalibration, PlanarView, ZhangOptions};
 use ocellus_image::convert::to_image_rgb8;
@@ -93,9 +93,6 @@ pub fn parse_pair(s: &str, what: &str, range: std::ops::RangeInclusive<usize>) -
 
 /// Inner-corner counts of a chessboard a detector can find (per row and per column).
 pub const BOARD_RANGE: std::ops::RangeInclusive<usize> = 2..=64;
-
-/// Image sides a camera file may record, pixels.
-pub const IMAGE_SIDE_RANGE: std::ops::RangeInclusive<usize> = 1..=65_536;
 
 /// A length with unit (`mm`, `cm`, `m`; bare numbers are mm) in millimetres.
 pub fn parse_length_mm(s: &str) -> Result<f64> {
@@ -191,7 +188,8 @@ pub fn run_chessboard(a: ChessboardArgs) -> Result<()> {
 /// Runs `calibrate planar`.
 pub fn run_planar(a: PlanarArgs) -> Result<()> {
     let rows = ocellus_io::csv::read_rows(&a.points, 5, "'view,X,Y,u,v'")?;
-    let size = a.image_size.as_deref().map(|s| parse_pair(s, "--image-size", IMAGE_SIDE_RANGE)).transpose()?;
+    let size =
+        a.image_size.as_deref().map(|s| parse_pair(s, "--image-size", camera_file::IMAGE_SIDE_RANGE)).transpose()?;
     let mut ids: Vec<i64> = Vec::new();
     let mut views: Vec<PlanarView> = Vec::new();
     for r in &rows {

@@ -3,11 +3,11 @@
 
 use crate::assets;
 use crate::calibrate_planar::{parse_length_mm, parse_pair};
-use crate::camera_file::{self, CameraFile};
 use crate::ranges;
 use anyhow::{Context, Result};
 use clap::Args;
 use ocellus_geometry::camera::Intrinsics;
+use ocellus_geometry::camera_file::{self, CameraFile};
 use ocellus_geometry::distortion::Distortion;
 use ocellus_image::resample::{resize, ResampleMethod};
 use ocellus_image::rng::SplitMix64;

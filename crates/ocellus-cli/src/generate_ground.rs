@@ -45,7 +45,8 @@ pub struct GroundArgs {
     #[arg(long)]
     y4m: bool,
     /// Output folder: frames/frame_NNNNN.png (or sequence.y4m), groundtruth.tum (the robot's
-    /// rotation centre, metres), encoders.csv (30 Hz wheel odometry with slip events),
+    /// rotation centre, metres), encoders.csv (30 Hz wheel odometry with slip events; the true
+    /// slip per reading in encoder_slips.csv),
     /// camera.toml (focal 600 px, height 0.3 m, mount 5 cm ahead: 0.5 mm per ground pixel).
     #[arg(long, default_value = "ocellus-ground")]
     out: PathBuf,
@@ -101,12 +102,18 @@ pub fn run(a: GroundArgs) -> Result<()> {
         w.finish()?;
     }
     ocellus_io::tum::write(a.out.join("groundtruth.tum"), &truth)?;
+    // What the wheels report, in the layout `ocellus odometry --encoders` reads; the slip they
+    // cannot know is ground truth and goes to its own file.
     let mut enc = create("encoders.csv")?;
-    writeln!(enc, "time_s,forward_m,yaw_rad,slip_m")?;
+    let mut slips = create("encoder_slips.csv")?;
+    writeln!(enc, "time_s,forward_m,yaw_rad")?;
+    writeln!(slips, "time_s,slip_m")?;
     for e in encoders(&scene, 30.0, 0.5, 0.002, a.seed)? {
-        writeln!(enc, "{:.6},{:.9},{:.9},{:.6}", e.time_s, e.forward_m, e.yaw_rad, e.slip_m)?;
+        writeln!(enc, "{:.6},{:.9},{:.9}", e.time_s, e.forward_m, e.yaw_rad)?;
+        writeln!(slips, "{:.6},{:.6}", e.time_s, e.slip_m)?;
     }
     enc.flush()?;
+    slips.flush()?;
     let mut cam = create("camera.toml")?;
     writeln!(
         cam,
@@ -121,7 +128,7 @@ pub fn run(a: GroundArgs) -> Result<()> {
     )?;
     cam.flush()?;
     outln!(
-        "{} frames {}x{} ({}{}) written to {} with groundtruth.tum, encoders.csv, camera.toml",
+        "{} frames {}x{} ({}{}) written to {} with groundtruth.tum, encoders.csv, encoder_slips.csv, camera.toml",
         scene.len(),
         cfg.width,
         cfg.height,

@@ -14,7 +14,7 @@ mod bench_planning;
 mod budget;
 mod calibrate_cmd;
 mod calibrate_planar;
-mod camera_file;
+
 mod config_file;
 mod corridor_sim;
 mod demo;

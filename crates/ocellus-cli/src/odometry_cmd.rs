@@ -1,12 +1,12 @@
 //! `ocellus odometry`: visual odometry of a ground-facing camera, and `ocellus odometry eval`:
 //! a trajectory against ground truth.
 
-use crate::camera_file;
 use crate::frames::for_each_frame;
 use crate::plot::{self, Plot, Series};
 use crate::ranges;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
+use ocellus_geometry::camera_file;
 use ocellus_geometry::distortion::{remap_bilinear, undistort_maps};
 use ocellus_image::Plane;
 use ocellus_io::tum::TumPose;
@@ -127,7 +127,7 @@ pub fn run(a: OdometryArgs) -> Result<()> {
     }
     let mut fusion = Fusion::new(FusionConfig { encoder_rate_hz: a.encoder_rate_hz, ..Default::default() }, mount);
     let mut vision_poses = Vec::new();
-    crate::inputs::check_out_dir(&a.out, &[input.clone()])?;
+    crate::inputs::check_out_dir(&a.out, std::slice::from_ref(input))?;
     crate::output_files::create_dir(&a.out)?;
     let d = cam.distortion;
     let distorted = [d.k1, d.k2, d.k3, d.p1, d.p2].iter().any(|v| *v != 0.0);
@@ -270,7 +270,7 @@ fn eval(a: &EvalArgs) -> Result<()> {
     let dist = |p: &TumPose, q: &TumPose| (p.position[0] - q.position[0]).hypot(p.position[1] - q.position[1]);
     let path: f64 = pairs.windows(2).map(|w| dist(&w[0].1, &w[1].1)).sum();
     let (le, lg) = pairs[pairs.len() - 1];
-    if !(path > 0.0) {
+    if path.is_nan() || path <= 0.0 {
         bail!("the paired ground-truth poses do not move (path length 0): drift is undefined");
     }
     let drift = 100.0 * dist(&le, &lg) / path;

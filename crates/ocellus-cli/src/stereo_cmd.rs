@@ -2,7 +2,7 @@
 //! point cloud.
 
 use crate::overlay;
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use ocellus_geometry::block_matching::{bad_pixels, block_match, BlockMatching};
 use ocellus_geometry::sgm::{Sgm, SgmMatcher, SgmPaths};
@@ -191,7 +191,7 @@ pub fn run(a: StereoArgs) -> Result<()> {
     let mut written = vec!["disparity.png", "disparity.pfm"];
     if let Some(tp) = &a.truth {
         let truth = ocellus_io::pfm::read(tp)?;
-        let (bad, density) = bad_pixels(&disp, &truth, 2.0)?;
+        let (bad, density) = bad_pixels(&disp, &truth, 2.0).with_context(|| format!("--truth {}", tp.display()))?;
         outln!("against {}: bad-2.0 {:.2} %, density {:.2} %", tp.display(), bad * 100.0, density * 100.0);
     }
     match (a.focal_px, a.baseline) {

@@ -1,9 +1,9 @@
 //! `ocellus undistort`: removes lens distortion from images with a calibrated camera.
 
-use crate::camera_file;
 use crate::inputs::{check_out_dir, collect_images, output_stems};
 use anyhow::{Context, Result};
 use clap::Args;
+use ocellus_geometry::camera_file;
 use ocellus_geometry::distortion::{remap_bilinear, undistort_maps};
 use ocellus_image::Plane;
 use std::path::PathBuf;

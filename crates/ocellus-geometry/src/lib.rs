@@ -30,6 +30,7 @@
 
 pub mod block_matching;
 pub mod camera;
+pub mod camera_file;
 pub mod chessboard;
 pub mod distortion;
 pub mod dlt;
@@ -102,6 +103,14 @@ pub enum GeometryError {
     /// A parameter is out of range.
     #[error("invalid parameter: {0}")]
     Invalid(String),
+    /// A camera file that cannot be read or used.
+    #[error("{path}: {reason}")]
+    CameraFile {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
 }
 
 /// Result type of this crate.
