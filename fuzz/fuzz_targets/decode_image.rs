@@ -4,5 +4,9 @@ use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = ocellus_io::decode_image(data, Path::new("fuzz.img"));
+    // A small pixel limit keeps the fuzzer's memory bounded; the limit itself is under test.
+    if let Ok(img) = ocellus_io::decode_image_within(data, Path::new("fuzz.img"), 1 << 22) {
+        let (w, h) = img.size();
+        assert!(w * h <= 1 << 22 && w > 0 && h > 0);
+    }
 });
