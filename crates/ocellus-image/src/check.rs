@@ -55,6 +55,24 @@ pub fn finite<T: Into<f64> + Copy + Display>(name: &str, v: T) -> Result<(), Str
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Each check accepts exactly the values of its range, whatever the bits of the number.
+        #[test]
+        fn checks_accept_exactly_their_range(bits in any::<u64>(), lo in -1e6f64..1e6, span in 0.0f64..1e6) {
+            let v = f64::from_bits(bits);
+            let hi = lo + span;
+            prop_assert_eq!(within("v", v, lo, hi).is_ok(), v >= lo && v <= hi);
+            prop_assert_eq!(between("v", v, lo, hi).is_ok(), v > lo && v < hi);
+            prop_assert_eq!(positive("v", v).is_ok(), v.is_finite() && v > 0.0);
+            prop_assert_eq!(non_negative("v", v).is_ok(), v.is_finite() && v >= 0.0);
+            prop_assert_eq!(finite("v", v).is_ok(), v.is_finite());
+            if let Err(m) = within("the_name", v, lo, hi) {
+                prop_assert!(m.starts_with("the_name = "));
+            }
+        }
+    }
 
     #[test]
     fn messages_name_the_parameter_and_nan_fails() {

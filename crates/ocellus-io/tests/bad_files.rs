@@ -52,3 +52,21 @@ fn a_y4m_without_frames_is_an_error() {
     assert!(matches!(Frames::open_within(&q, 1_000_000), Err(IoError::TooLarge { .. })));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+proptest::proptest! {
+    /// Whatever the text, the CSV reader returns rows of exactly the asked number of finite
+    /// numbers, or an error; rows written from numbers read back equal.
+    #[test]
+    fn csv_rows_have_exactly_the_asked_columns(text in "[0-9a-z,;. \\t\\n#eE+-]{0,200}", columns in 1usize..6) {
+        if let Ok(rows) = ocellus_io::csv::parse_rows(text.as_bytes(), Path::new("p.csv"), columns, "numbers") {
+            proptest::prop_assert!(rows.iter().all(|r| r.len() == columns && r.iter().all(|v| v.is_finite())));
+        }
+    }
+
+    #[test]
+    fn csv_round_trip(rows in proptest::collection::vec(proptest::collection::vec(-1e9f64..1e9, 3), 0..20)) {
+        let text: String = rows.iter().map(|r| format!("{},{},{}\n", r[0], r[1], r[2])).collect();
+        let back = ocellus_io::csv::parse_rows(text.as_bytes(), Path::new("p.csv"), 3, "numbers").unwrap();
+        proptest::prop_assert_eq!(back, rows);
+    }
+}
