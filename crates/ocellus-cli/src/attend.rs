@@ -80,17 +80,16 @@ struct Outputs {
     dir: PathBuf,
     overlays: bool,
     video: Option<VideoWriter>,
-    scanpath: std::io::BufWriter<std::fs::File>,
-    context: std::io::BufWriter<std::fs::File>,
+    scanpath: crate::output_files::OutputFile,
+    context: crate::output_files::OutputFile,
     chaos: Vec<(f64, f64)>,
     surprise_max: Vec<(f64, f64)>,
     recent: Vec<Fixation>,
     saccades: usize,
 }
 
-fn create(dir: &Path, name: &str) -> Result<std::io::BufWriter<std::fs::File>> {
-    let p = dir.join(name);
-    Ok(std::io::BufWriter::new(std::fs::File::create(&p).with_context(|| format!("cannot create {}", p.display()))?))
+fn create(dir: &Path, name: &str) -> Result<crate::output_files::OutputFile> {
+    crate::output_files::create_file(&dir.join(name))
 }
 
 impl Outputs {

@@ -116,12 +116,8 @@ pub fn write_sequence(cfg: SceneConfig, out: &Path, y4m: bool) -> Result<()> {
     let g = scene(cfg)?;
     let a = Out { out: out.to_path_buf(), y4m };
     crate::output_files::create_dir(&a.out)?;
-    let create = |name: &str| -> Result<std::io::BufWriter<std::fs::File>> {
-        let p = a.out.join(name);
-        Ok(std::io::BufWriter::new(
-            std::fs::File::create(&p).with_context(|| format!("cannot create {}", p.display()))?,
-        ))
-    };
+    let create =
+        |name: &str| -> Result<crate::output_files::OutputFile> { crate::output_files::create_file(&a.out.join(name)) };
     let mut truth = create("truth.csv")?;
     writeln!(truth, "frame,pan_deg,tilt_deg,object_x,object_y,object_w,object_h,event")?;
     let mut pan_tilt = create("pan_tilt.csv")?;

@@ -70,9 +70,7 @@ pub fn run(a: ChessboardArgs) -> Result<()> {
     crate::output_files::create_dir(&a.out)?;
     camera_file::write(&a.out.join("camera_truth.toml"), &truth)?;
     let csv_path = a.out.join("corners_truth.csv");
-    let mut csv = std::io::BufWriter::new(
-        std::fs::File::create(&csv_path).with_context(|| format!("cannot create {}", csv_path.display()))?,
-    );
+    let mut csv = crate::output_files::create_file(&csv_path)?;
     writeln!(csv, "view,X_mm,Y_mm,u_px,v_px")?;
     let mut rng = SplitMix64::new(a.seed);
     for v in 0..a.views {

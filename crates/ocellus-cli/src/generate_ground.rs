@@ -73,12 +73,8 @@ pub fn run(a: GroundArgs) -> Result<()> {
     let cfg = GroundConfig { frames: a.frames, ..base };
     let scene = GroundScene::new(cfg, textures()?)?;
     crate::output_files::create_dir(&a.out)?;
-    let create = |name: &str| -> Result<std::io::BufWriter<std::fs::File>> {
-        let p = a.out.join(name);
-        Ok(std::io::BufWriter::new(
-            std::fs::File::create(&p).with_context(|| format!("cannot create {}", p.display()))?,
-        ))
-    };
+    let create =
+        |name: &str| -> Result<crate::output_files::OutputFile> { crate::output_files::create_file(&a.out.join(name)) };
     let mut y4m =
         if a.y4m { Some(Y4mWriter::new(create("sequence.y4m")?, cfg.width, cfg.height, (200, 1))?) } else { None };
     if !a.y4m {

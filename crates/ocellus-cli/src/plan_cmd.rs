@@ -2,7 +2,7 @@
 
 use crate::corridor_sim::{self, RunConfig, StepRecord};
 use crate::{overlay, plot};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, Subcommand};
 use ocellus_image::convert::to_image_rgb8;
 use ocellus_image::Plane;
@@ -66,9 +66,7 @@ fn annotate(world: &Corridor, r: &StepRecord, frame: &ocellus_image::convert::Rg
 }
 
 fn write_csv(path: &Path, records: &[StepRecord]) -> Result<()> {
-    let mut f = std::io::BufWriter::new(
-        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?,
-    );
+    let mut f = crate::output_files::create_file(path)?;
     let mut header = "step,true_x_m,true_y_m,est_x_m,est_y_m,cov_trace_m2,chaos_bits,v,pan_deg,landmarks_observed,surprise_max_bits,person_in_view,person_bearing_deg,person_bearing_next_deg,chosen_pan_deg".to_string();
     if let Some(r) = records.first() {
         for c in &r.decision.candidates {

@@ -2,7 +2,7 @@
 
 use crate::attend::StreamOptions;
 use crate::{frames, overlay};
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 use ocellus_attention::stream::StreamEngine;
 use ocellus_image::convert::to_image_rgb8;
@@ -36,9 +36,7 @@ pub fn run(a: SurpriseArgs) -> Result<()> {
     }
     crate::output_files::create_dir(&maps)?;
     let csv_path = a.out.join("surprise.csv");
-    let mut csv = std::io::BufWriter::new(
-        std::fs::File::create(&csv_path).with_context(|| format!("cannot create {}", csv_path.display()))?,
-    );
+    let mut csv = crate::output_files::create_file(&csv_path)?;
     writeln!(csv, "frame,surprise_max_bits,x,y,chaos_bits")?;
     let mut engine: Option<StreamEngine> = None;
     let mut peak = (0.0f32, 0usize);

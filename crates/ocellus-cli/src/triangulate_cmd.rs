@@ -57,9 +57,7 @@ pub fn run(a: TriangulateArgs) -> Result<()> {
     let ps: Vec<Matrix3x4<f64>> = a.cameras.iter().map(|c| read_camera(c)).collect::<Result<_>>()?;
     ocellus_geometry::triangulate::check_rig(&ps).context("the --camera files cannot triangulate")?;
     let rows = ocellus_io::csv::read_rows(&a.matches, 2 * ps.len(), "a pixel 'u,v' per camera")?;
-    let mut out = std::io::BufWriter::new(
-        std::fs::File::create(&a.out).with_context(|| format!("cannot create {}", a.out.display()))?,
-    );
+    let mut out = crate::output_files::create_file(&a.out)?;
     writeln!(out, "x,y,z,in_front,rms_px")?;
     let (mut n, mut behind) = (0usize, 0usize);
     for (i, row) in rows.iter().enumerate() {
