@@ -43,8 +43,9 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<Plane<f32>> {
     let h: usize = tokens[2].parse().map_err(|_| bad("bad height"))?;
     let scale: f32 = tokens[3].parse().map_err(|_| bad("bad scale"))?;
     let start = i + 1;
-    let n = w.checked_mul(h).ok_or_else(|| bad("size overflows"))?;
-    let body = bytes.get(start..start + n * 4).ok_or_else(|| bad("truncated data"))?;
+    let end = w.checked_mul(h).and_then(|n| n.checked_mul(4)).and_then(|b| b.checked_add(start));
+    let end = end.ok_or_else(|| bad("size overflows"))?;
+    let body = bytes.get(start..end).ok_or_else(|| bad("truncated data"))?;
     let le = scale < 0.0;
     let mut p = Plane::new(w, h);
     for (k, c) in body.chunks_exact(4).enumerate() {

@@ -70,3 +70,20 @@ proptest::proptest! {
         proptest::prop_assert_eq!(back, rows);
     }
 }
+
+/// Headers whose sizes overflow when multiplied (found by the fuzzers): errors, not panics
+/// or wrapped sizes.
+#[test]
+fn overflowing_sizes_in_headers_are_errors() {
+    let pfm = b"Pf\n77777777777777777777 2\n-1.0\n\0\0\0\0";
+    assert!(ocellus_io::pfm::parse(pfm, Path::new("o.pfm")).is_err());
+    let pfm = b"Pf\n4611686018427387904 2\n-1.0\n\0\0\0\0";
+    assert!(ocellus_io::pfm::parse(pfm, Path::new("o.pfm")).is_err());
+    let header = "{'descr': '<f4', 'fortran_order': False, 'shape': (4294967296, 4294967296, 16), }";
+    let mut npy = b"\x93NUMPY\x01\x00".to_vec();
+    npy.extend((header.len() as u16).to_le_bytes());
+    npy.extend(header.as_bytes());
+    npy.extend([0u8; 16]);
+    let e = ocellus_io::npy::parse(&npy, Path::new("o.npy")).unwrap_err();
+    assert!(e.to_string().contains("overflow"), "{e}");
+}
