@@ -21,16 +21,41 @@ fn merge(base: &mut toml::Value, over: toml::Value) {
     }
 }
 
+/// Adds the `[[channels]]` of an override to the preset's channels: an entry of a kind the
+/// preset has replaces that channel (to change its weight), any other is appended. The README's
+/// example, a skin channel, thus keeps intensity, colour and orientation.
+fn merge_channels(base: &mut toml::Value, over: &mut toml::Value) {
+    let Some(new) = over.as_table_mut().and_then(|t| t.remove("channels")) else { return };
+    let Some(list) = base.get_mut("channels").and_then(toml::Value::as_array_mut) else { return };
+    for entry in new.as_array().cloned().unwrap_or_default() {
+        match list.iter_mut().find(|c| c.get("kind").is_some() && c.get("kind") == entry.get("kind")) {
+            Some(existing) => *existing = entry,
+            None => list.push(entry),
+        }
+    }
+}
+
 /// The preset `preset`, with the fields given in the TOML file `file` replaced.
 ///
 /// The file uses the field names of `SaliencyConfig` (see `ocellus saliency --print-config`),
-/// e.g. `map_level = 3` or `[gabor]\nsize = 15`.
+/// e.g. `map_level = 3` or `[gabor]\nsize = 15`. `[[channels]]` entries add to the preset's
+/// channels (an entry of a kind the preset has replaces that one); with
+/// `replace_channels = true` at the top of the file they replace the whole list.
 pub fn load(preset: &str, file: Option<&Path>) -> Result<SaliencyConfig> {
     let base = SaliencyConfig::preset(preset)?;
     let Some(file) = file else { return Ok(base) };
     let text = std::fs::read_to_string(file).with_context(|| format!("cannot read config file {}", file.display()))?;
-    let over: toml::Value = toml::from_str(&text).with_context(|| format!("{} is not valid TOML", file.display()))?;
+    let mut over: toml::Value =
+        toml::from_str(&text).with_context(|| format!("{} is not valid TOML", file.display()))?;
+    let replace = match over.as_table_mut().and_then(|t| t.remove("replace_channels")) {
+        None => false,
+        Some(toml::Value::Boolean(b)) => b,
+        Some(v) => anyhow::bail!("{}: replace_channels must be true or false, not {v}", file.display()),
+    };
     let mut value = toml::Value::try_from(&base).context("cannot serialize preset")?;
+    if !replace {
+        merge_channels(&mut value, &mut over);
+    }
     merge(&mut value, over);
     let cfg: SaliencyConfig =
         value.try_into().with_context(|| format!("{}: invalid saliency configuration", file.display()))?;
@@ -77,5 +102,40 @@ mod tests {
             assert!(e.contains(key), "{text}: {e}");
         }
         assert!(load("nope", None).is_err());
+    }
+
+    /// The README's example adds a skin channel and keeps the preset's three; an entry of an
+    /// existing kind changes that channel; `replace_channels` replaces the list.
+    #[test]
+    fn channels_add_unless_replaced_and_kernels_normalize() {
+        use ocellus_attention::config::ChannelKind;
+        let dir = std::env::temp_dir().join(format!("ocellus-cfg-ch-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let f = dir.join("c.toml");
+        let kinds = |c: &SaliencyConfig| c.channels.iter().map(|c| c.kind.clone()).collect::<Vec<_>>();
+        let preset = SaliencyConfig::ace2009();
+        std::fs::write(&f, "map_level = 4\n[gabor]\nsize = 15\n\n[[channels]]\nkind = \"skin\"\nweight = 0.5\n")
+            .unwrap();
+        let c = load("ace2009", Some(&f)).unwrap();
+        let mut want = kinds(&preset);
+        want.push(ChannelKind::Skin);
+        assert_eq!(kinds(&c), want);
+        assert_eq!(c.channels.last().unwrap().weight, 0.5);
+        std::fs::write(&f, "[[channels]]\nkind = \"intensity\"\nweight = 2.0\n").unwrap();
+        let c = load("ace2009", Some(&f)).unwrap();
+        assert_eq!(kinds(&c), kinds(&preset));
+        assert_eq!(c.channels.iter().find(|c| c.kind == ChannelKind::Intensity).unwrap().weight, 2.0);
+        std::fs::write(&f, "replace_channels = true\n[[channels]]\nkind = \"skin\"\nweight = 1.0\n").unwrap();
+        assert_eq!(kinds(&load("ace2009", Some(&f)).unwrap()), vec![ChannelKind::Skin]);
+        std::fs::write(&f, "replace_channels = 3\n").unwrap();
+        assert!(load("ace2009", Some(&f)).is_err());
+        // Kernels from a file are normalized (the seed's integers), and at most 16 taps.
+        std::fs::write(&f, "[pyramid]\ntaps = [1.0, 5.0, 10.0, 10.0, 5.0, 1.0]\norigin = 2\n").unwrap();
+        assert_eq!(load("ace2009", Some(&f)).unwrap().pyramid, preset.pyramid);
+        std::fs::write(&f, format!("[pyramid]\ntaps = [{}]\norigin = 8\n", vec!["1.0"; 17].join(", "))).unwrap();
+        assert!(format!("{:#}", load("ace2009", Some(&f)).unwrap_err()).contains("16"));
+        std::fs::write(&f, "[pyramid]\ntaps = [0.0, 0.0]\norigin = 0\n").unwrap();
+        assert!(load("ace2009", Some(&f)).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

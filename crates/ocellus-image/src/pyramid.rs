@@ -11,8 +11,12 @@ use crate::{dispatch_kernel, Backend, ImageError, Plane, Result};
 use serde::{Deserialize, Serialize};
 
 /// The 1D low-pass kernel of a pyramid and where its origin lies.
+///
+/// Read from a configuration file, the taps are checked and normalized to sum 1 like
+/// [`PyramidKernel::new`] does (`taps = [1, 5, 10, 10, 5, 1]` is the seed's kernel, not one
+/// with a gain of 32).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "RawPyramidKernel")]
 pub struct PyramidKernel {
     /// Taps (any positive weights; normalized to sum 1 on construction).
     pub taps: Vec<f32>,
@@ -22,6 +26,27 @@ pub struct PyramidKernel {
     /// `(x0 + 2 x1 + x2) / 4` (its `gaussianSubsample`). Off: the general rule.
     #[serde(default)]
     pub stb_size3_rule: bool,
+}
+
+/// A kernel as written in a file, before checking and normalization.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPyramidKernel {
+    taps: Vec<f32>,
+    origin: usize,
+    #[serde(default)]
+    stb_size3_rule: bool,
+}
+
+impl TryFrom<RawPyramidKernel> for PyramidKernel {
+    type Error = ImageError;
+
+    fn try_from(r: RawPyramidKernel) -> Result<Self> {
+        // Checked before normalizing, so that a zero or non-finite sum never divides.
+        let raw = PyramidKernel { taps: r.taps, origin: r.origin, stb_size3_rule: r.stb_size3_rule };
+        raw.validate()?;
+        Ok(Self::new(&raw.taps, raw.origin, raw.stb_size3_rule))
+    }
 }
 
 impl PyramidKernel {
@@ -47,9 +72,11 @@ impl PyramidKernel {
     pub fn validate(&self) -> Result<()> {
         let s: f32 = self.taps.iter().sum();
         if self.taps.is_empty()
+            || self.taps.len() > MAX_TAPS
             || self.origin >= self.taps.len()
             || self.taps.iter().any(|t| !t.is_finite() || *t < 0.0)
             || s <= 0.0
+            || !s.is_finite()
         {
             return Err(ImageError::InvalidParameter(format!(
                 "pyramid kernel {:?} with origin {} must have 1..=16 non-negative finite taps, with the origin inside",
