@@ -48,18 +48,19 @@ struct AttentionArgs {
     /// Number of frames. Range: 2..=100000.
     #[arg(long, default_value_t = 30, value_parser = ranges::within(2usize, 100_000))]
     frames: usize,
-    /// First frame showing the object (sudden). Range: 1..=100000, and below --frames.
-    #[arg(long, default_value_t = 15, value_parser = ranges::within(1usize, 100_000))]
-    event_frame: usize,
+    /// First frame showing the object [default: 15]; `--scenario sudden` only. Range:
+    /// 1..=100000, and below --frames.
+    #[arg(long, value_parser = ranges::within(1usize, 100_000))]
+    event_frame: Option<usize>,
     /// Seed of the sensor noise. Range: any 64-bit unsigned integer.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Sensor noise, standard deviation in grey levels. Range: 0..=100.
     #[arg(long, default_value_t = 2.0, value_parser = ranges::within(0.0f32, 100.0))]
     noise: f32,
-    /// Pan speed, pixels per frame (pan). Range: -100..=100.
-    #[arg(long, default_value_t = 6.0, value_parser = ranges::within(-100.0f32, 100.0))]
-    pan_px_per_frame: f32,
+    /// Pan speed, pixels per frame [default: 6]; `--scenario pan` only. Range: -100..=100.
+    #[arg(long, value_parser = ranges::within(-100.0f32, 100.0))]
+    pan_px_per_frame: Option<f32>,
     /// Write one Y4M video instead of PNG frames.
     #[arg(long)]
     y4m: bool,
@@ -92,19 +93,22 @@ pub fn run(a: GenerateArgs) -> Result<()> {
         ScenarioArg::Sudden => Scenario::SuddenObject,
         ScenarioArg::Pan => Scenario::Pan,
     };
-    if a.event_frame >= a.frames {
-        anyhow::bail!(
-            "--event-frame {} must be below --frames {}: the object would never appear",
-            a.event_frame,
-            a.frames
-        );
+    if a.event_frame.is_some() && !matches!(scenario, Scenario::SuddenObject) {
+        anyhow::bail!("--event-frame belongs to --scenario sudden; this scenario has no event");
+    }
+    if a.pan_px_per_frame.is_some() && !matches!(scenario, Scenario::Pan) {
+        anyhow::bail!("--pan-px-per-frame belongs to --scenario pan; this scenario does not pan");
+    }
+    let (event_frame, pan_px_per_frame) = (a.event_frame.unwrap_or(15), a.pan_px_per_frame.unwrap_or(6.0));
+    if matches!(scenario, Scenario::SuddenObject) && event_frame >= a.frames {
+        anyhow::bail!("--event-frame {event_frame} must be below --frames {}: the object would never appear", a.frames);
     }
     let cfg = SceneConfig {
         frames: a.frames,
-        event_frame: a.event_frame,
+        event_frame,
         seed: a.seed,
         noise_sigma: a.noise,
-        pan_px_per_frame: a.pan_px_per_frame,
+        pan_px_per_frame,
         ..SceneConfig::new(scenario)
     };
     write_sequence(cfg, &a.out, a.y4m)

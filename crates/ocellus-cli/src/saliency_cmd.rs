@@ -29,8 +29,8 @@ pub struct SaliencyArgs {
     /// Print the time of each pipeline stage for every image (milliseconds).
     #[arg(long)]
     pub timings: bool,
-    /// Print the effective configuration as TOML and exit.
-    #[arg(long)]
+    /// Print the effective configuration as TOML and exit (no images are read).
+    #[arg(long, conflicts_with_all = ["images", "conspicuity", "timings", "out"])]
     pub print_config: bool,
 }
 

@@ -53,10 +53,10 @@ pub struct StereoArgs {
     /// Baseline, in the unit wanted for depths (e.g. mm). Range: above 0, at most 1e9.
     #[arg(long, value_parser = crate::ranges::above(0.0f64, 1e9))]
     pub baseline: Option<f64>,
-    /// Principal point x offset between the cameras (Middlebury doffs), pixels. Range:
-    /// -100000..=100000.
-    #[arg(long, default_value_t = 0.0, value_parser = crate::ranges::within(-1e5f64, 1e5))]
-    pub doffs: f64,
+    /// Principal point x offset between the cameras (Middlebury doffs), pixels [default: 0];
+    /// with --focal-px and --baseline. Range: -100000..=100000.
+    #[arg(long, value_parser = crate::ranges::within(-1e5f64, 1e5))]
+    pub doffs: Option<f64>,
     /// Output folder: disparity.png, disparity.pfm, and depth.pfm, points.ply with calibration.
     #[arg(long, default_value = "ocellus-stereo")]
     pub out: PathBuf,
@@ -114,6 +114,13 @@ fn write_cloud(
 
 /// Runs the subcommand.
 pub fn run(a: StereoArgs) -> Result<()> {
+    // Checked before the matching, which takes a while.
+    match (a.focal_px, a.baseline) {
+        (Some(_), Some(_)) => {}
+        (None, None) if a.doffs.is_some() => bail!("--doffs is used with --focal-px and --baseline (the depth map)"),
+        (None, None) => {}
+        _ => bail!("--focal-px and --baseline go together"),
+    }
     let (li, ri) = (crate::budget::read_image(&a.left)?, crate::budget::read_image(&a.right)?);
     if li.size() != ri.size() {
         bail!("the images differ in size: {:?} and {:?}", li.size(), ri.size());
@@ -194,16 +201,12 @@ pub fn run(a: StereoArgs) -> Result<()> {
         let (bad, density) = bad_pixels(&disp, &truth, 2.0).with_context(|| format!("--truth {}", tp.display()))?;
         outln!("against {}: bad-2.0 {:.2} %, density {:.2} %", tp.display(), bad * 100.0, density * 100.0);
     }
-    match (a.focal_px, a.baseline) {
-        (Some(f), Some(b)) => {
-            let rig = ParallelStereo { baseline: b, focal_px: f };
-            let (n, depth) = write_cloud(&a.out.join("points.ply"), &disp, &li, &rig, a.doffs)?;
-            ocellus_io::pfm::write(a.out.join("depth.pfm"), &depth)?;
-            outln!("{n} points (units of the baseline, left camera frame)");
-            written.extend(["depth.pfm", "points.ply"]);
-        }
-        (None, None) => {}
-        _ => bail!("--focal-px and --baseline go together"),
+    if let (Some(f), Some(b)) = (a.focal_px, a.baseline) {
+        let rig = ParallelStereo { baseline: b, focal_px: f };
+        let (n, depth) = write_cloud(&a.out.join("points.ply"), &disp, &li, &rig, a.doffs.unwrap_or(0.0))?;
+        ocellus_io::pfm::write(a.out.join("depth.pfm"), &depth)?;
+        outln!("{n} points (units of the baseline, left camera frame)");
+        written.extend(["depth.pfm", "points.ply"]);
     }
     outln!("wrote {} in {}", written.join(", "), a.out.display());
     Ok(())

@@ -56,6 +56,7 @@ const CASES: &[Case] = &[
     c("saliency {D}/a --out {D}/a", Error(&["holds the input"])),
     c("saliency {D}/img.png --out {D}/img.png", Error(&["img.png"])),
     c("saliency", Usage(&["images"])),
+    c("saliency --print-config {D}/img.png", Usage(&["--print-config"])),
     c("saliency {D}/img.png --no-such-flag", Usage(&["--no-such-flag"])),
     c("saliency {D}/img.png {D}/missing.png --out {O}", Error(&["missing.png", "1 of 2 images failed"])),
     // ---- eval
@@ -219,6 +220,7 @@ const CASES: &[Case] = &[
     c("stereo {D}/img.png {D}/small.png --out {O}", Error(&["differ in size"])),
     c("stereo {D}/img.png {D}/img.png --truth {D}/small.pfm --out {O}", Error(&["small.pfm"])),
     c("stereo {D}/img.png {D}/img.png --focal-px 500 --out {O}", Error(&["--baseline"])),
+    c("stereo {D}/img.png {D}/img.png --doffs 3 --out {O}", Error(&["--doffs", "--focal-px"])),
     c("stereo {D}/img.png {D}/img.png --truth {D}/img.png --out {O}", Error(&["img.png"])),
     // ---- generate
     c("generate attention --frames 0 --out {O}", Usage(&["--frames", "range"])),
@@ -228,6 +230,8 @@ const CASES: &[Case] = &[
     c("generate attention --frames 10 --event-frame 40 --out {O}", Error(&["--event-frame"])),
     c("generate attention --pan-px-per-frame 1e9 --out {O}", Usage(&["--pan-px-per-frame", "range"])),
     c("generate attention --scenario nope --out {O}", Usage(&["nope"])),
+    c("generate attention --scenario static --event-frame 3 --out {O}", Error(&["--event-frame", "sudden"])),
+    c("generate attention --pan-px-per-frame 3 --out {O}", Error(&["--pan-px-per-frame", "pan"])),
     c("generate chessboard --noise -1 --out {O}", Usage(&["--noise", "range"])),
     c("generate chessboard --views 0 --out {O}", Usage(&["--views", "range"])),
     c("generate chessboard --max-tilt-deg 89 --out {O}", Usage(&["--max-tilt-deg", "range"])),

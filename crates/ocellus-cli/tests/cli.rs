@@ -217,12 +217,10 @@ fn eval_location_metrics_from_csv_points_and_binary_maps_agree() {
 
 fn generate(dir: &std::path::Path, scenario: &str, frames: usize, event: usize, y4m: bool) {
     let mut c = ocellus();
-    c.args(["generate", "attention", "--scenario", scenario, "--frames"])
-        .arg(frames.to_string())
-        .arg("--event-frame")
-        .arg(event.to_string())
-        .arg("--out")
-        .arg(dir);
+    c.args(["generate", "attention", "--scenario", scenario, "--frames"]).arg(frames.to_string()).arg("--out").arg(dir);
+    if scenario == "sudden" {
+        c.arg("--event-frame").arg(event.to_string());
+    }
     if y4m {
         c.arg("--y4m");
     }
