@@ -9,6 +9,29 @@ set +e
 cargo test --workspace --locked 2>&1 | tee "$log"
 status=${PIPESTATUS[0]}
 set -e
+# The examples that show the API on real images must run, too.
+examples=(
+  "ocellus-attention saliency_peak"
+  "ocellus-attention attend_sequence"
+  "ocellus-synth calibrate_chessboards"
+  "ocellus-geometry stereo_depth"
+  "ocellus-fovea logpolar_register"
+  "ocellus-odometry floor_odometry"
+)
+ran=0
+for e in "${examples[@]}"; do
+  set -- $e
+  if [ "$status" -eq 0 ]; then
+    if cargo run -q --locked -p "$1" --example "$2" > "$log.example" 2>&1; then
+      ran=$((ran + 1))
+    else
+      cat "$log.example"
+      echo "example $2 of $1 failed"
+      status=1
+    fi
+  fi
+done
+rm -f "$log.example"
 # One closing line for the whole suite (cargo prints one per test binary).
-awk '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed\n", p, f }' "$log"
+awk -v ran="$ran" -v all="${#examples[@]}" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed; examples: %d of %d ran\n", p, f, ran, all }' "$log"
 exit "$status"

@@ -86,14 +86,7 @@ pub fn process_one(
     }
     let s = e.saliency();
     let (mw, mh) = s.size();
-    let (mut best, mut bx, mut by) = (f32::NEG_INFINITY, 0, 0);
-    for y in 0..mh {
-        for (x, &v) in s.row(y).iter().enumerate() {
-            if v > best {
-                (best, bx, by) = (v, x, y);
-            }
-        }
-    }
+    let (bx, by, _) = s.argmax().unwrap_or((0, 0, 0.0));
     let peak_px = ((bx as f32 + 0.5) * w as f32 / mw as f32, (by as f32 + 0.5) * h as f32 / mh as f32);
     Ok(SaliencyResult { map_size: (mw, mh), peak_px, files })
 }

@@ -152,6 +152,20 @@ impl<T: Copy + Default> Plane<T> {
 }
 
 impl Plane<f32> {
+    /// The first pixel (in row order) holding the largest value: `(x, y, value)`; `None` for
+    /// an empty plane or one of only NaN.
+    pub fn argmax(&self) -> Option<(usize, usize, f32)> {
+        let mut best: Option<(usize, usize, f32)> = None;
+        for (y, r) in self.rows().enumerate() {
+            for (x, &v) in r.iter().enumerate() {
+                if best.map_or(true, |b| v > b.2) && !v.is_nan() {
+                    best = Some((x, y, v));
+                }
+            }
+        }
+        best
+    }
+
     /// (min, max) over all pixels; (0, 0) for an empty plane. NaN pixels are ignored.
     pub fn min_max(&self) -> (f32, f32) {
         let mut mn = f32::INFINITY;
