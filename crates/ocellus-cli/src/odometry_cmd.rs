@@ -6,6 +6,7 @@ use crate::plot::{self, Plot, Series};
 use crate::ranges;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
+use ocellus_eval::trajectory::{self, PlanarPose};
 use ocellus_geometry::camera_file;
 use ocellus_geometry::distortion::{remap_bilinear, undistort_maps};
 use ocellus_image::Plane;
@@ -244,55 +245,23 @@ fn plot_trajectories(path: &Path, runs: &[(&str, &[TumPose], RGBColor)]) -> Resu
     )
 }
 
-fn wrap(a: f64) -> f64 {
-    (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
-}
-
 fn eval(a: &EvalArgs) -> Result<()> {
     let est = ocellus_io::tum::read(&a.estimate)?;
     let gt = ocellus_io::tum::read(&a.truth)?;
-    // Pair each ground-truth pose with the estimate nearest in time.
-    let mut pairs = Vec::new();
-    let mut j = 0;
-    for g in &gt {
-        while j + 1 < est.len() && (est[j + 1].time_s - g.time_s).abs() <= (est[j].time_s - g.time_s).abs() {
-            j += 1;
-        }
-        if let Some(e) = est.get(j) {
-            if (e.time_s - g.time_s).abs() <= a.max_dt {
-                pairs.push((*e, *g));
-            }
-        }
-    }
-    if pairs.len() < 2 {
-        bail!("only {} poses pair up within {} s: do the timestamps match?", pairs.len(), a.max_dt);
-    }
-    let dist = |p: &TumPose, q: &TumPose| (p.position[0] - q.position[0]).hypot(p.position[1] - q.position[1]);
-    let path: f64 = pairs.windows(2).map(|w| dist(&w[0].1, &w[1].1)).sum();
-    let (le, lg) = pairs[pairs.len() - 1];
-    if path.is_nan() || path <= 0.0 {
-        bail!("the paired ground-truth poses do not move (path length 0): drift is undefined");
-    }
-    let drift = 100.0 * dist(&le, &lg) / path;
-    let heading = wrap(le.yaw() - lg.yaw()).to_degrees().abs();
-    let ate = (pairs.iter().map(|(e, g)| dist(e, g).powi(2)).sum::<f64>() / pairs.len() as f64).sqrt();
-    // Relative pose error over one step, translation part, in the frame of the first pose.
-    let rel = |p: &TumPose, q: &TumPose| {
-        let (dx, dy) = (q.position[0] - p.position[0], q.position[1] - p.position[1]);
-        let (s, c) = p.yaw().sin_cos();
-        (c * dx + s * dy, -s * dx + c * dy, wrap(q.yaw() - p.yaw()))
-    };
-    let rpe: Vec<f64> = pairs
-        .windows(2)
-        .map(|w| {
-            let (e, g) = (rel(&w[0].0, &w[1].0), rel(&w[0].1, &w[1].1));
-            (e.0 - g.0).hypot(e.1 - g.1)
-        })
-        .collect();
-    let rpe_rmse = (rpe.iter().map(|v| v * v).sum::<f64>() / rpe.len() as f64).sqrt();
-    outln!("{} poses paired, path {:.4} m", pairs.len(), path);
-    outln!("final drift {drift:.4} % of the path, final heading error {heading:.4} deg");
-    outln!("ATE RMSE {:.3} mm, RPE per frame RMSE {:.4} mm", ate * 1e3, rpe_rmse * 1e3);
+    let planar = |p: &TumPose| PlanarPose::new(p.time_s, p.position[0], p.position[1], p.yaw());
+    let (est_p, gt_p): (Vec<PlanarPose>, Vec<PlanarPose>) =
+        (est.iter().map(planar).collect(), gt.iter().map(planar).collect());
+    let e = trajectory::errors(&est_p, &gt_p, a.max_dt)?;
+    outln!("{} poses paired, path {:.4} m", e.pairs, e.path_m);
+    outln!(
+        "final drift {:.4} % of the path, final heading error {:.4} deg",
+        e.final_drift_percent,
+        e.final_heading_deg
+    );
+    outln!("ATE RMSE {:.3} mm, RPE per frame RMSE {:.4} mm", e.ate_rmse_m * 1e3, e.rpe_rmse_m * 1e3);
+    // The plot shows the paired poses of both.
+    let pairs: Vec<(TumPose, TumPose)> =
+        trajectory::pair_by_time(&est_p, &gt_p, a.max_dt).into_iter().map(|(i, j)| (est[i], gt[j])).collect();
     let (e, g): (Vec<TumPose>, Vec<TumPose>) = pairs.into_iter().unzip();
     plot_trajectories(&a.plot, &[("ground truth", &g, RGBColor(30, 30, 30)), ("estimate", &e, RGBColor(200, 40, 40))])?;
     outln!("wrote {}", a.plot.display());

@@ -15,6 +15,7 @@
 //! ```
 
 pub mod metrics;
+pub mod trajectory;
 
 use thiserror::Error;
 

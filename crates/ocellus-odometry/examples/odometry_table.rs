@@ -3,6 +3,7 @@
 //! frames each. `cargo run --release -p ocellus-odometry --example odometry_table`.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use ocellus_eval::trajectory::{final_drift, path_length, PlanarPose};
 use ocellus_image::Plane;
 use ocellus_odometry::kinematics::Mount;
 use ocellus_odometry::vo::{OdometryConfig, VisualOdometry};
@@ -28,17 +29,17 @@ fn main() {
                     .enumerate()
                 {
                     let mut vo = VisualOdometry::new(vo_cfg).unwrap();
-                    let mut path = 0.0;
-                    let mut last = scene.pose_m(0).unwrap();
+                    let mut truth = Vec::with_capacity(frames.len());
                     for (k, f) in frames.iter().enumerate() {
                         vo.step(f).unwrap();
-                        let p = scene.pose_m(k).unwrap();
-                        path += ((p.0 - last.0).powi(2) + (p.1 - last.1).powi(2)).sqrt();
-                        last = p;
+                        let (x, y, yaw) = scene.pose_m(k).unwrap();
+                        truth.push(PlanarPose::new(k as f64, x, y, yaw));
                     }
-                    let e = vo.pose();
-                    rows[mi].0.push(100.0 * ((e.x - last.0).powi(2) + (e.y - last.1).powi(2)).sqrt() / path);
-                    rows[mi].1.push((e.theta - last.2).to_degrees().abs());
+                    let (e, end) = (vo.pose(), truth[truth.len() - 1]);
+                    let est = PlanarPose::new(end.time_s, e.x, e.y, e.theta);
+                    let (drift, heading) = final_drift(&est, &end, path_length(&truth)).unwrap();
+                    rows[mi].0.push(drift);
+                    rows[mi].1.push(heading);
                 }
             }
             for (mi, (d, h)) in rows.iter().enumerate() {

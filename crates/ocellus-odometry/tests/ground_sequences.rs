@@ -1,6 +1,7 @@
 //! The seed's visual odometry on generated ground sequences built from the real textures.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use ocellus_eval::trajectory::{final_drift, path_length, PlanarPose};
 use ocellus_image::Plane;
 use ocellus_odometry::kinematics::Mount;
 use ocellus_odometry::vo::{OdometryConfig, VisualOdometry};
@@ -19,18 +20,15 @@ fn run(scene: &GroundScene, robust: bool) -> (f64, f64) {
     let mount = Mount { right_m: c.mount_px[0] * c.metres_per_px, forward_m: c.mount_px[1] * c.metres_per_px };
     let cfg = if robust { OdometryConfig::robust(0.3, 600.0, mount) } else { OdometryConfig::seed(0.3, 600.0, mount) };
     let mut vo = VisualOdometry::new(cfg).unwrap();
-    let mut path = 0.0;
-    let mut last = scene.pose_m(0).unwrap();
+    let mut truth = Vec::with_capacity(scene.len());
     for k in 0..scene.len() {
         vo.step(&scene.frame(k).unwrap()).unwrap();
-        let p = scene.pose_m(k).unwrap();
-        path += ((p.0 - last.0).powi(2) + (p.1 - last.1).powi(2)).sqrt();
-        last = p;
+        let (x, y, yaw) = scene.pose_m(k).unwrap();
+        truth.push(PlanarPose::new(k as f64, x, y, yaw));
     }
-    let est = vo.pose();
-    let err = ((est.x - last.0).powi(2) + (est.y - last.1).powi(2)).sqrt();
-    let drift = if path > 0.0 { 100.0 * err / path } else { err };
-    (drift, (est.theta - last.2).to_degrees().abs())
+    let e = vo.pose();
+    let end = truth[truth.len() - 1];
+    final_drift(&PlanarPose::new(end.time_s, e.x, e.y, e.theta), &end, path_length(&truth)).unwrap()
 }
 
 #[test]

@@ -1,0 +1,183 @@
+//! How far an estimated planar trajectory is from the truth (SPEC 6): final drift as a
+//! percentage of the path, final heading error, absolute trajectory error (ATE, RMSE of the
+//! positions) and relative pose error over one step (RPE, translation part), after pairing
+//! the poses by time.
+//!
+//! Poses are planar: x and y in metres in a fixed world frame, yaw in radians about +z. The
+//! metrics follow Sturm et al., "A benchmark for the evaluation of RGB-D SLAM systems", IROS
+//! 2012 (ATE and RPE), without alignment: odometry starts at the true pose.
+//!
+//! ```
+//! use ocellus_eval::trajectory::{errors, PlanarPose};
+//! let truth: Vec<PlanarPose> = (0..5).map(|k| PlanarPose::new(k as f64, k as f64, 0.0, 0.0)).collect();
+//! let est: Vec<PlanarPose> = truth.iter().map(|p| PlanarPose { y_m: 0.1 * p.x_m, ..*p }).collect();
+//! let e = errors(&est, &truth, 0.01).unwrap();
+//! assert!((e.final_drift_percent - 10.0).abs() < 1e-9); // 0.4 m off after a 4 m path
+//! ```
+
+use crate::{EvalError, Result};
+
+/// A pose of a robot on the ground plane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanarPose {
+    /// Time stamp, seconds.
+    pub time_s: f64,
+    /// Position, metres.
+    pub x_m: f64,
+    /// Position, metres.
+    pub y_m: f64,
+    /// Heading, radians about +z.
+    pub yaw_rad: f64,
+}
+
+impl PlanarPose {
+    /// A pose from its time, position and heading.
+    pub fn new(time_s: f64, x_m: f64, y_m: f64, yaw_rad: f64) -> Self {
+        Self { time_s, x_m, y_m, yaw_rad }
+    }
+
+    fn distance(&self, o: &PlanarPose) -> f64 {
+        (self.x_m - o.x_m).hypot(self.y_m - o.y_m)
+    }
+}
+
+/// An angle wrapped to (-pi, pi], radians.
+pub fn wrap_angle(a: f64) -> f64 {
+    let w = a.rem_euclid(std::f64::consts::TAU);
+    if w > std::f64::consts::PI {
+        w - std::f64::consts::TAU
+    } else {
+        w
+    }
+}
+
+/// Length of the polyline through the positions, metres.
+pub fn path_length(poses: &[PlanarPose]) -> f64 {
+    poses.windows(2).map(|w| w[0].distance(&w[1])).sum()
+}
+
+/// Final position error in percent of `path_m`, and the final heading error in degrees, of an
+/// estimated end pose against the true one.
+pub fn final_drift(estimate: &PlanarPose, truth: &PlanarPose, path_m: f64) -> Result<(f64, f64)> {
+    if !(path_m.is_finite() && path_m > 0.0) {
+        return Err(EvalError::Undefined { metric: "drift", why: format!("the true path has length {path_m} m") });
+    }
+    Ok((100.0 * estimate.distance(truth) / path_m, wrap_angle(estimate.yaw_rad - truth.yaw_rad).to_degrees().abs()))
+}
+
+/// For each true pose, the index of the estimate nearest in time if it is within `max_dt_s`
+/// seconds: `(estimate index, truth index)` pairs, in time order. Both lists must be sorted
+/// by time (TUM files are; see `ocellus_io::tum`); one pass, linear in their lengths.
+pub fn pair_by_time(estimate: &[PlanarPose], truth: &[PlanarPose], max_dt_s: f64) -> Vec<(usize, usize)> {
+    let mut pairs = Vec::new();
+    let mut j = 0;
+    for (i, g) in truth.iter().enumerate() {
+        while j + 1 < estimate.len()
+            && (estimate[j + 1].time_s - g.time_s).abs() <= (estimate[j].time_s - g.time_s).abs()
+        {
+            j += 1;
+        }
+        if estimate.get(j).is_some_and(|e| (e.time_s - g.time_s).abs() <= max_dt_s) {
+            pairs.push((j, i));
+        }
+    }
+    pairs
+}
+
+/// The errors of an estimated trajectory.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrajectoryErrors {
+    /// Poses paired by time.
+    pub pairs: usize,
+    /// Length of the true path over the paired poses, metres.
+    pub path_m: f64,
+    /// Final position error, percent of the path.
+    pub final_drift_percent: f64,
+    /// Final heading error, degrees.
+    pub final_heading_deg: f64,
+    /// Absolute trajectory error: RMSE of the positions, metres.
+    pub ate_rmse_m: f64,
+    /// Relative pose error over one step, translation part: RMSE, metres.
+    pub rpe_rmse_m: f64,
+}
+
+/// Pairs the poses by time (within `max_dt_s`) and measures the errors; an error when fewer
+/// than two poses pair up or the true path does not move.
+pub fn errors(estimate: &[PlanarPose], truth: &[PlanarPose], max_dt_s: f64) -> Result<TrajectoryErrors> {
+    let pairs: Vec<(PlanarPose, PlanarPose)> =
+        pair_by_time(estimate, truth, max_dt_s).into_iter().map(|(i, j)| (estimate[i], truth[j])).collect();
+    if pairs.len() < 2 {
+        return Err(EvalError::Undefined {
+            metric: "trajectory errors",
+            why: format!("only {} poses pair up within {max_dt_s} s: do the timestamps match?", pairs.len()),
+        });
+    }
+    let (est, gt): (Vec<PlanarPose>, Vec<PlanarPose>) = pairs.iter().copied().unzip();
+    let path_m = path_length(&gt);
+    let (last_e, last_g) = pairs[pairs.len() - 1];
+    let (final_drift_percent, final_heading_deg) = final_drift(&last_e, &last_g, path_m)
+        .map_err(|_| EvalError::Undefined { metric: "drift", why: "the paired true poses do not move".into() })?;
+    let ate_rmse_m = (pairs.iter().map(|(e, g)| e.distance(g).powi(2)).sum::<f64>() / pairs.len() as f64).sqrt();
+    // One step of each trajectory in the frame of its own first pose.
+    let step = |p: &PlanarPose, q: &PlanarPose| {
+        let (dx, dy) = (q.x_m - p.x_m, q.y_m - p.y_m);
+        let (s, c) = p.yaw_rad.sin_cos();
+        (c * dx + s * dy, -s * dx + c * dy)
+    };
+    let rpe: Vec<f64> = est
+        .windows(2)
+        .zip(gt.windows(2))
+        .map(|(e, g)| {
+            let (a, b) = (step(&e[0], &e[1]), step(&g[0], &g[1]));
+            (a.0 - b.0).hypot(a.1 - b.1)
+        })
+        .collect();
+    let rpe_rmse_m = (rpe.iter().map(|v| v * v).sum::<f64>() / rpe.len() as f64).sqrt();
+    Ok(TrajectoryErrors { pairs: pairs.len(), path_m, final_drift_percent, final_heading_deg, ate_rmse_m, rpe_rmse_m })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn circle(n: usize, r: f64) -> Vec<PlanarPose> {
+        (0..n)
+            .map(|k| {
+                let a = k as f64 * 0.01;
+                PlanarPose::new(k as f64 * 0.005, r * a.sin(), r * (1.0 - a.cos()), a)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn closed_forms_on_a_circle() {
+        let truth = circle(101, 2.0);
+        // The arc of 1 rad on a 2 m circle is 2 m long (the chords, to 1e-5).
+        assert!((path_length(&truth) - 2.0).abs() < 1e-4);
+        let e = errors(&truth, &truth, 1e-6).unwrap();
+        assert_eq!((e.pairs, e.ate_rmse_m, e.rpe_rmse_m, e.final_drift_percent), (101, 0.0, 0.0, 0.0));
+        // Shifted by 3 cm everywhere: ATE 3 cm, RPE 0, drift 3 cm over the path, heading 0.
+        let shifted: Vec<PlanarPose> = truth.iter().map(|p| PlanarPose { x_m: p.x_m + 0.03, ..*p }).collect();
+        let e = errors(&shifted, &truth, 1e-6).unwrap();
+        assert!((e.ate_rmse_m - 0.03).abs() < 1e-12 && e.rpe_rmse_m < 1e-12);
+        assert!((e.final_drift_percent - 3.0 / e.path_m).abs() < 1e-9 && e.final_heading_deg < 1e-9);
+        // A heading 2 degrees off at the end; angles wrap across +-180.
+        let (_, h) =
+            final_drift(&PlanarPose::new(0.0, 0.0, 0.0, 3.13), &PlanarPose::new(0.0, 0.0, 0.0, -3.13), 1.0).unwrap();
+        assert!((h - (2.0 * std::f64::consts::PI - 6.26).to_degrees()).abs() < 1e-9, "{h}");
+    }
+
+    #[test]
+    fn pairing_and_undefined_cases() {
+        let truth = circle(10, 1.0);
+        let late: Vec<PlanarPose> = truth.iter().map(|p| PlanarPose { time_s: p.time_s + 1.0, ..*p }).collect();
+        assert!(errors(&late, &truth, 0.001).is_err());
+        let still: Vec<PlanarPose> = truth.iter().map(|p| PlanarPose { x_m: 0.0, y_m: 0.0, ..*p }).collect();
+        assert!(errors(&still, &still, 0.001).is_err());
+        // Every other estimate: each true pose pairs with its own time or not at all.
+        let half: Vec<PlanarPose> = truth.iter().step_by(2).copied().collect();
+        assert_eq!(pair_by_time(&half, &truth, 1e-6).len(), 5);
+        assert_eq!(pair_by_time(&half, &truth, 0.006).len(), 10);
+        assert!((wrap_angle(3.0 * std::f64::consts::PI) - std::f64::consts::PI).abs() < 1e-12);
+    }
+}
