@@ -30,7 +30,7 @@ pub struct LogPolarArgs {
     #[arg(long, default_value_t = 128, value_parser = ranges::within(4usize, 4096))]
     sectors: usize,
     /// Gaze point `X,Y` in pixels (pixel centres at integers) [default: the image centre].
-    #[arg(long, value_parser = parse_point)]
+    #[arg(long, value_parser = ranges::point)]
     fovea: Option<[f64; 2]>,
     /// Fovea radius rho_0, pixels [default: outer radius / 60, at least 2]. Range: 0.5..=100000,
     /// and below the outer radius.
@@ -95,7 +95,7 @@ struct VergenceArgs {
     /// Right image (rectified with the left).
     right: PathBuf,
     /// Gaze point `X,Y` in the left image, pixels.
-    #[arg(long, value_parser = parse_point)]
+    #[arg(long, value_parser = ranges::point)]
     gaze: [f64; 2],
     /// Largest disparity searched, pixels. Range: 1..=1024.
     #[arg(long, default_value_t = 64, value_parser = ranges::within(1i64, 1024))]
@@ -106,19 +106,6 @@ struct VergenceArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
-}
-
-fn parse_point(s: &str) -> std::result::Result<[f64; 2], String> {
-    let v: Vec<&str> = s.split(',').collect();
-    if v.len() != 2 {
-        return Err(format!("expected X,Y, got '{s}'"));
-    }
-    let p = |t: &str| t.trim().parse::<f64>().map_err(|e| format!("'{t}': {e}"));
-    let (x, y) = (p(v[0])?, p(v[1])?);
-    if !(x.is_finite() && y.is_finite()) {
-        return Err(format!("'{s}' is not a finite point"));
-    }
-    Ok([x, y])
 }
 
 fn grey_f32(path: &Path) -> Result<Plane<f32>> {

@@ -43,6 +43,20 @@ where
     }
 }
 
+/// A parser of a point `X,Y` of two finite numbers (pixels).
+pub fn point(s: &str) -> Result<[f64; 2], String> {
+    let v: Vec<&str> = s.split(',').collect();
+    if v.len() != 2 {
+        return Err(format!("expected X,Y, got '{s}'"));
+    }
+    let p = |t: &str| t.trim().parse::<f64>().map_err(|e| format!("'{t}': {e}"));
+    let (x, y) = (p(v[0])?, p(v[1])?);
+    if !(x.is_finite() && y.is_finite()) {
+        return Err(format!("'{s}' is not a finite point"));
+    }
+    Ok([x, y])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -6,10 +6,10 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use ocellus_geometry::block_matching::{bad_pixels, block_match, BlockMatching};
 use ocellus_geometry::sgm::{Sgm, SgmMatcher, SgmPaths};
-use ocellus_geometry::stereo::ParallelStereo;
-use ocellus_image::convert::{to_image_rgb8, RgbImage};
+use ocellus_geometry::stereo::{depth_and_points, ParallelStereo};
+use ocellus_image::convert::to_image_rgb8;
 use ocellus_image::Plane;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Arguments of `ocellus stereo`.
@@ -57,6 +57,10 @@ pub struct StereoArgs {
     /// with --focal-px and --baseline. Range: -100000..=100000.
     #[arg(long, value_parser = crate::ranges::within(-1e5f64, 1e5))]
     pub doffs: Option<f64>,
+    /// Principal point `X,Y` of the left camera, pixels (pixel centres at integers), for the
+    /// point cloud [default: the image centre]; with --focal-px and --baseline.
+    #[arg(long, value_parser = crate::ranges::point)]
+    pub principal_point: Option<[f64; 2]>,
     /// Output folder: disparity.png, disparity.pfm, and depth.pfm, points.ply with calibration.
     #[arg(long, default_value = "ocellus-stereo")]
     pub out: PathBuf,
@@ -83,41 +87,14 @@ fn disparity_image(d: &Plane<f32>, max: f32) -> Plane<[u8; 3]> {
     })
 }
 
-fn write_cloud(
-    path: &Path,
-    disp: &Plane<f32>,
-    colour: &RgbImage,
-    rig: &ParallelStereo,
-    doffs: f64,
-) -> Result<(usize, Plane<f32>)> {
-    let (w, h) = disp.size();
-    let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
-    let mut depth = Plane::from_fn(w, h, |_, _| f32::NAN);
-    let mut pts = Vec::new();
-    let px = colour.to_u8();
-    for y in 0..h {
-        for x in 0..w {
-            let d = disp.get(x, y);
-            if !d.is_finite() {
-                continue;
-            }
-            // Zero total disparity is infinite depth: left out, not divided by.
-            if let Ok(p) = rig.point(x as f64, y as f64, d as f64 + doffs, cx, cy) {
-                depth.set(x, y, p[2] as f32);
-                pts.push(([p[0] as f32, p[1] as f32, p[2] as f32], px.get(x, y)));
-            }
-        }
-    }
-    ocellus_io::ply::write(path, &pts)?;
-    Ok((pts.len(), depth))
-}
-
 /// Runs the subcommand.
 pub fn run(a: StereoArgs) -> Result<()> {
     // Checked before the matching, which takes a while.
     match (a.focal_px, a.baseline) {
         (Some(_), Some(_)) => {}
-        (None, None) if a.doffs.is_some() => bail!("--doffs is used with --focal-px and --baseline (the depth map)"),
+        (None, None) if a.doffs.is_some() || a.principal_point.is_some() => {
+            bail!("--doffs and --principal-point are used with --focal-px and --baseline (the depth map)")
+        }
         (None, None) => {}
         _ => bail!("--focal-px and --baseline go together"),
     }
@@ -203,9 +180,19 @@ pub fn run(a: StereoArgs) -> Result<()> {
     }
     if let (Some(f), Some(b)) = (a.focal_px, a.baseline) {
         let rig = ParallelStereo { baseline: b, focal_px: f };
-        let (n, depth) = write_cloud(&a.out.join("points.ply"), &disp, &li, &rig, a.doffs.unwrap_or(0.0))?;
+        let (w, h) = disp.size();
+        let centre = a.principal_point.unwrap_or([(w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0]);
+        let (depth, cloud) = depth_and_points(&disp, &rig, centre, a.doffs.unwrap_or(0.0))?;
+        let colour = li.to_u8();
+        let pts: Vec<([f32; 3], [u8; 3])> = cloud.iter().map(|p| (p.xyz, colour.get(p.pixel.0, p.pixel.1))).collect();
+        ocellus_io::ply::write(a.out.join("points.ply"), &pts)?;
         ocellus_io::pfm::write(a.out.join("depth.pfm"), &depth)?;
-        outln!("{n} points (units of the baseline, left camera frame)");
+        outln!(
+            "{} points (units of the baseline, left camera frame, principal point ({:.1}, {:.1}) px)",
+            pts.len(),
+            centre[0],
+            centre[1]
+        );
         written.extend(["depth.pfm", "points.ply"]);
     }
     outln!("wrote {} in {}", written.join(", "), a.out.display());

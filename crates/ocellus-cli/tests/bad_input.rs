@@ -221,6 +221,8 @@ const CASES: &[Case] = &[
     c("stereo {D}/img.png {D}/img.png --truth {D}/small.pfm --out {O}", Error(&["small.pfm"])),
     c("stereo {D}/img.png {D}/img.png --focal-px 500 --out {O}", Error(&["--baseline"])),
     c("stereo {D}/img.png {D}/img.png --doffs 3 --out {O}", Error(&["--doffs", "--focal-px"])),
+    c("stereo {D}/img.png {D}/img.png --principal-point 3,4 --out {O}", Error(&["--principal-point", "--focal-px"])),
+    c("stereo {D}/img.png {D}/img.png --principal-point 3 --out {O}", Usage(&["--principal-point", "x,y"])),
     c("stereo {D}/img.png {D}/img.png --truth {D}/img.png --out {O}", Error(&["img.png"])),
     // ---- generate
     c("generate attention --frames 0 --out {O}", Usage(&["--frames", "range"])),

@@ -344,7 +344,8 @@ fn stereo_writes_disparity_depth_cloud_and_scores_against_truth() {
         .arg(d.join("motorcycle_right.png"))
         .arg("--truth")
         .arg(d.join("motorcycle_disp.pfm"))
-        .args(["--focal-px", "994.978", "--baseline", "193.001", "--doffs", "31.086", "--out"])
+        .args(["--focal-px", "994.978", "--baseline", "193.001", "--doffs", "31.086"])
+        .args(["--principal-point", "311.193,254.877", "--out"])
         .arg(&out)
         .output()
         .unwrap();
