@@ -83,7 +83,9 @@ fn read_line<R: BufRead>(r: &mut R, path: &Path, what: &str) -> Result<Option<Ve
 
 fn parse_header(line: &[u8], path: &Path) -> Result<Y4mHeader> {
     let bad = |reason: String| IoError::Corrupt { path: path.into(), reason };
-    let text = std::str::from_utf8(line).map_err(|_| bad("header is not ASCII".into()))?;
+    // ASCII, not just UTF-8: tags are split after their first byte (found by fuzzing).
+    let text =
+        std::str::from_utf8(line).ok().filter(|t| t.is_ascii()).ok_or_else(|| bad("header is not ASCII".into()))?;
     let mut tokens = text.split(' ').filter(|t| !t.is_empty());
     if tokens.next() != Some("YUV4MPEG2") {
         return Err(bad("not a YUV4MPEG2 stream".into()));
@@ -333,7 +335,14 @@ mod tests {
 
     #[test]
     fn bad_headers_are_errors() {
-        for s in [&b""[..], b"P6\n", b"YUV4MPEG2 W0 H2\n", b"YUV4MPEG2 W4 H2 C420p10\n", b"YUV4MPEG2 W4 H2"] {
+        for s in [
+            &b""[..],
+            b"P6\n",
+            b"YUV4MPEG2 W0 H2\n",
+            b"YUV4MPEG2 W4 H2 C420p10\n",
+            b"YUV4MPEG2 W4 H2",
+            "YUV4MPEG2 W4 H2 \u{37a}4\n".as_bytes(),
+        ] {
             assert!(Y4mReader::new(s, Path::new("t.y4m")).is_err(), "{:?}", String::from_utf8_lossy(s));
         }
         let s = b"YUV4MPEG2 W2 H2 C444\nFROG\n".to_vec();
