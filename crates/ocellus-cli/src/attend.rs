@@ -7,7 +7,7 @@ use clap::Args;
 use ocellus_attention::attention::{Fixation, Reason};
 use ocellus_attention::stream::{StreamConfig, StreamEngine, StreamFrame};
 use ocellus_attention::surprise::SurpriseConfig;
-use ocellus_image::convert::{to_image_rgb8, RgbImage};
+use ocellus_image::convert::RgbImage;
 use ocellus_image::Plane;
 use ocellus_io::video_writer::VideoWriter;
 use plotters::style::RGBColor;
@@ -157,7 +157,7 @@ impl Outputs {
         let img = composite(frame, r, &self.recent)?;
         if self.overlays {
             let p = self.dir.join("overlays").join(format!("frame_{k:05}.png"));
-            ocellus_io::write_png(&p, &to_image_rgb8(&img))?;
+            ocellus_io::write_png(&p, &img)?;
         }
         if k == 0 {
             self.video = VideoWriter::start(&self.dir.join("overlays.mp4"), img.width(), img.height(), fps)?;

@@ -1,7 +1,7 @@
 //! `ocellus bench`: the figures the issues ask for, printed as a table or one JSON object.
 
 use crate::{assets, ranges};
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use clap::{Args, ValueEnum};
 use ocellus_attention::{SaliencyConfig, SaliencyEngine};
 use ocellus_image::{convert::RgbImage, Backend, Plane};
@@ -91,16 +91,19 @@ impl BenchArgs {
 
 fn frames(a: &BenchArgs) -> Result<Vec<RgbImage>> {
     let (width, height) = a.size();
-    let decoded: Vec<image::DynamicImage> = match &a.image {
-        Some(p) => vec![image::open(p).with_context(|| format!("cannot read {}", p.display()))?],
-        None => {
-            assets::IMAGES.iter().map(|(_, b)| image::load_from_memory(b)).collect::<std::result::Result<_, _>>()?
-        }
+    // Decoded as every command decodes (format checks, memory budget); resized by `image`.
+    let decoded: Vec<RgbImage> = match &a.image {
+        Some(p) => vec![crate::budget::read_image(p)?],
+        None => assets::IMAGES
+            .iter()
+            .map(|(n, b)| ocellus_io::decode_image(b, std::path::Path::new(n)))
+            .collect::<std::result::Result<_, _>>()?,
     };
     decoded
         .iter()
         .map(|d| {
-            let r = image::imageops::resize(&d.to_rgb8(), width, height, image::imageops::FilterType::Triangle);
+            let rgb = ocellus_image::convert::to_image_rgb8(&d.to_u8());
+            let r = image::imageops::resize(&rgb, width, height, image::imageops::FilterType::Triangle);
             let data = r.pixels().map(|p| p.0).collect();
             Ok(RgbImage::U8(Plane::from_vec(width as usize, height as usize, data)?))
         })

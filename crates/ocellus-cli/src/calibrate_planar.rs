@@ -9,7 +9,6 @@ use clap::Args;
 use ocellus_geometry::camera_file::{self, CameraFile};
 use ocellus_geometry::chessboard::{find_chessboard, ChessboardOptions};
 use ocellus_geometry::zhang::{calibrate, project_view, PlanarCalibration, PlanarView, ZhangOptions};
-use ocellus_image::convert::to_image_rgb8;
 use ocellus_image::Plane;
 use rayon::prelude::*;
 use serde_json::json;
@@ -179,7 +178,7 @@ pub fn run_chessboard(a: ChessboardArgs) -> Result<()> {
             draw_ring(&mut img, p[0] as f32, p[1] as f32, 5.0, [0, 220, 0]);
             draw_ring(&mut img, q[0] as f32, q[1] as f32, 1.5, [255, 0, 0]);
         }
-        ocellus_io::write_png(a.out.join("corners").join(format!("{}.png", stem(f))), &to_image_rgb8(&img))?;
+        ocellus_io::write_png(a.out.join("corners").join(format!("{}.png", stem(f))), &img)?;
     }
     let names: Vec<String> = used.iter().map(|f| f.display().to_string()).collect();
     report(&a.out, &cal, size, &names, "chessboard", square)

@@ -4,7 +4,7 @@ use crate::assets;
 use crate::ranges;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
-use ocellus_image::convert::{to_image_rgb8, RgbImage};
+use ocellus_image::convert::RgbImage;
 use ocellus_io::y4m::Y4mWriter;
 use ocellus_synth::attention_scenes::{Scenario, SceneConfig, SceneGenerator};
 use std::io::Write;
@@ -136,9 +136,7 @@ pub fn write_sequence(cfg: SceneConfig, out: &Path, y4m: bool) -> Result<()> {
         let (frame, t) = g.frame(k)?;
         match &mut y4m {
             Some(w) => w.write_frame(&frame)?,
-            None => {
-                ocellus_io::write_png(frames_dir.join(format!("frame_{k:05}.png")), &to_image_rgb8(&frame.to_u8()))?
-            }
+            None => ocellus_io::write_png(frames_dir.join(format!("frame_{k:05}.png")), &frame.to_u8())?,
         }
         let o = t.object.map(|r| format!("{},{},{},{}", r.x, r.y, r.w, r.h)).unwrap_or_else(|| ",,,".into());
         writeln!(truth, "{k},{:.4},{:.4},{o},{}", t.pan_deg, t.tilt_deg, u8::from(t.event))?;

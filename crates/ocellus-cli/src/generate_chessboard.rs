@@ -76,9 +76,7 @@ pub fn run(a: ChessboardArgs) -> Result<()> {
     for v in 0..a.views {
         let pose = cam.random_pose(&board, a.max_tilt_deg.to_radians(), &mut rng)?;
         let img = cam.render(&board, &pose, Some(&background), 3, a.noise, a.seed.wrapping_mul(1000) + v as u64)?;
-        let grey = image::GrayImage::from_fn(w as u32, h as u32, |x, y| {
-            image::Luma([(img.get(x as usize, y as usize) * 255.0).round() as u8])
-        });
+        let grey = ocellus_image::convert::to_grey8(&img, 0.0, 1.0);
         ocellus_io::write_png(a.out.join(format!("view_{v:02}.png")), &grey)?;
         let corners = cam.corners(&board, &pose).context("a corner is behind the camera")?;
         for (o, p) in board.inner_corners().iter().zip(corners) {

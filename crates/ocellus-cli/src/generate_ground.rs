@@ -86,9 +86,7 @@ pub fn run(a: GroundArgs) -> Result<()> {
         match &mut y4m {
             Some(w) => w.write_frame(&RgbImage::U8(f.map(|v| [v, v, v])))?,
             None => {
-                let img = image::GrayImage::from_raw(cfg.width as u32, cfg.height as u32, f.to_vec())
-                    .context("frame buffer size")?;
-                ocellus_io::write_png(a.out.join("frames").join(format!("frame_{k:05}.png")), &img)?;
+                ocellus_io::write_png(a.out.join("frames").join(format!("frame_{k:05}.png")), &f)?;
             }
         }
         let (x, y, th) = scene.pose_m(k).context("pose")?;

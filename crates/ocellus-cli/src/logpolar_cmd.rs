@@ -222,7 +222,7 @@ fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
             .collect::<std::result::Result<_, _>>()?;
         let [r, g, b] = [&planes[0], &planes[1], &planes[2]];
         let cortex = to_rgb8([r, g, b]);
-        ocellus_io::write_png(cortex_dir.join(format!("{k:05}.png")), &ocellus_image::convert::to_image_rgb8(&cortex))?;
+        ocellus_io::write_png(cortex_dir.join(format!("{k:05}.png")), &cortex)?;
         let even = |p: &Plane<[u8; 3]>| {
             let (pw, ph) = p.size();
             Plane::from_fn(pw + pw % 2, ph + ph % 2, |x, y| p.get(x.min(pw - 1), y.min(ph - 1)))
@@ -266,9 +266,9 @@ fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
 /// Writes the cortical image of `rgb` under `map` and its inverse as PNG files.
 pub fn write_foveated(map: &LogPolarMap, rgb: &Plane<[u8; 3]>, cortex_png: &Path, inverse_png: &Path) -> Result<()> {
     let [r, g, b] = map.sample_rgb(rgb)?;
-    ocellus_io::write_png(cortex_png, &ocellus_image::convert::to_image_rgb8(&to_rgb8([&r, &g, &b])))?;
+    ocellus_io::write_png(cortex_png, &to_rgb8([&r, &g, &b]))?;
     let (ir, ig, ib) = (map.inverse(&r)?, map.inverse(&g)?, map.inverse(&b)?);
-    ocellus_io::write_png(inverse_png, &ocellus_image::convert::to_image_rgb8(&to_rgb8([&ir, &ig, &ib])))?;
+    ocellus_io::write_png(inverse_png, &to_rgb8([&ir, &ig, &ib]))?;
     Ok(())
 }
 

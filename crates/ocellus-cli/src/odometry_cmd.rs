@@ -198,10 +198,7 @@ pub fn run(a: OdometryArgs) -> Result<()> {
 /// The frame with its flow vectors drawn 5x longer (green) from their group centres (red).
 fn write_flow(path: &Path, grey: &Plane<u8>, flows: &[ocellus_odometry::sad_flow::FlowPoint]) -> Result<()> {
     let (w, h) = grey.size();
-    let mut img = image::RgbImage::from_fn(w as u32, h as u32, |x, y| {
-        let v = grey.get(x as usize, y as usize);
-        image::Rgb([v, v, v])
-    });
+    let mut img = grey.map(|v| [v, v, v]);
     let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
     for f in flows {
         let (x0, y0) = (f.u + cx, f.v + cy);
@@ -209,13 +206,13 @@ fn write_flow(path: &Path, grey: &Plane<u8>, flows: &[ocellus_odometry::sad_flow
             let t = s as f64 / 50.0 * 5.0;
             let (x, y) = ((x0 + t * f.du).round(), (y0 + t * f.dv).round());
             if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
-                img.put_pixel(x as u32, y as u32, image::Rgb([0, 230, 0]));
+                img.set(x as usize, y as usize, [0, 230, 0]);
             }
         }
         for (dx, dy) in [(0i64, 0i64), (1, 0), (-1, 0), (0, 1), (0, -1)] {
             let (x, y) = (x0.round() as i64 + dx, y0.round() as i64 + dy);
             if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
-                img.put_pixel(x as u32, y as u32, image::Rgb([230, 0, 0]));
+                img.set(x as usize, y as usize, [230, 0, 0]);
             }
         }
     }

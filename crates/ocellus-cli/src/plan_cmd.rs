@@ -4,7 +4,6 @@ use crate::corridor_sim::{self, RunConfig, StepRecord};
 use crate::{overlay, plot};
 use anyhow::Result;
 use clap::{Args, Subcommand};
-use ocellus_image::convert::to_image_rgb8;
 use ocellus_image::Plane;
 use ocellus_synth::corridor::Corridor;
 use plotters::style::RGBColor;
@@ -116,7 +115,7 @@ pub fn run(a: PlanArgs) -> Result<()> {
     crate::output_files::create_dir(&frames)?;
     let records = corridor_sim::run(&cfg, &world, |r, frame| {
         let path = frames.join(format!("step_{:02}.png", r.step));
-        Ok(ocellus_io::write_png(path, &to_image_rgb8(&annotate(&world, r, frame)))?)
+        Ok(ocellus_io::write_png(path, &annotate(&world, r, frame))?)
     })?;
     write_csv(&a.out.join("steps.csv"), &records)?;
     // Chosen angle per step; with --event, the run without it beside.

@@ -40,7 +40,11 @@ pub fn draw(path: &Path, plot: &Plot) -> Result<()> {
     let (w, h) = (960u32, 480u32);
     let mut buf = vec![0u8; (w * h * 3) as usize];
     render(&mut buf, (w, h), plot).map_err(|e| anyhow!("plot {}: {e}", path.display()))?;
-    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot buffer size"))?;
+    let img = ocellus_image::Plane::from_vec(
+        w as usize,
+        h as usize,
+        buf.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+    )?;
     ocellus_io::write_png(path, &img)?;
     Ok(())
 }

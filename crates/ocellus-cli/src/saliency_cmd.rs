@@ -47,7 +47,7 @@ pub struct SaliencyResult {
 fn write_map(out: &Path, name: &str, map: &Plane<f32>, files: &mut Vec<PathBuf>) -> Result<()> {
     let (_, mx) = map.min_max();
     let png = out.join(format!("{name}.png"));
-    ocellus_io::write_png(&png, &convert::to_image_gray8(map, 0.0, if mx > 0.0 { mx } else { 1.0 }))?;
+    ocellus_io::write_png(&png, &convert::to_grey8(map, 0.0, if mx > 0.0 { mx } else { 1.0 }))?;
     let npy = out.join(format!("{name}.npy"));
     ocellus_io::npy::write_plane(&npy, map)?;
     files.extend([png, npy]);
@@ -75,7 +75,7 @@ pub fn process_one(
     let mut full = Plane::default();
     e.saliency_full_size(&mut full)?;
     let ov = out.join(format!("{stem}.overlay.png"));
-    ocellus_io::write_png(&ov, &convert::to_image_rgb8(&overlay::overlay(&img.to_u8(), &full)))?;
+    ocellus_io::write_png(&ov, &overlay::overlay(&img.to_u8(), &full))?;
     files.push(ov);
     if conspicuity {
         let maps: Vec<(String, Plane<f32>)> =

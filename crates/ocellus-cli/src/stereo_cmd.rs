@@ -7,7 +7,6 @@ use clap::{Args, ValueEnum};
 use ocellus_geometry::block_matching::{bad_pixels, block_match, BlockMatching};
 use ocellus_geometry::sgm::{Sgm, SgmMatcher, SgmPaths};
 use ocellus_geometry::stereo::{depth_and_points, ParallelStereo};
-use ocellus_image::convert::to_image_rgb8;
 use ocellus_image::Plane;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -162,7 +161,7 @@ pub fn run(a: StereoArgs) -> Result<()> {
         }
     };
     crate::output_files::create_dir(&a.out)?;
-    ocellus_io::write_png(a.out.join("disparity.png"), &to_image_rgb8(&disparity_image(&disp, a.max_disp as f32)))?;
+    ocellus_io::write_png(a.out.join("disparity.png"), &disparity_image(&disp, a.max_disp as f32))?;
     ocellus_io::pfm::write(a.out.join("disparity.pfm"), &disp)?;
     let valid = disp.to_vec().iter().filter(|v| v.is_finite()).count();
     outln!(

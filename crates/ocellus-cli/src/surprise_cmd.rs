@@ -5,7 +5,6 @@ use crate::{frames, overlay};
 use anyhow::{bail, Result};
 use clap::Args;
 use ocellus_attention::stream::StreamEngine;
-use ocellus_image::convert::to_image_rgb8;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -65,7 +64,7 @@ pub fn run(a: SurpriseArgs) -> Result<()> {
             peak = (best, k);
         }
         let img = overlay::overlay_scaled(&overlay::half_size(&frame.to_u8()), m, 10.0)?;
-        ocellus_io::write_png(maps.join(format!("frame_{k:05}.png")), &to_image_rgb8(&img))?;
+        ocellus_io::write_png(maps.join(format!("frame_{k:05}.png")), &img)?;
         if a.npy {
             ocellus_io::npy::write_plane(maps.join(format!("frame_{k:05}.npy")), m)?;
         }

@@ -50,8 +50,8 @@ pub fn run(a: UndistortArgs) -> Result<()> {
         let channels: Vec<Plane<f32>> = (0..3)
             .map(|c| remap_bilinear(&img.map(|p| p[c] as f32), &*mx, &*my, 0.0))
             .collect::<std::result::Result<_, _>>()?;
-        let out = image::RgbImage::from_fn(size.0 as u32, size.1 as u32, |x, y| {
-            image::Rgb(std::array::from_fn(|c| channels[c].get(x as usize, y as usize).round().clamp(0.0, 255.0) as u8))
+        let out = Plane::from_fn(size.0, size.1, |x, y| {
+            std::array::from_fn(|c| channels[c].get(x, y).round().clamp(0.0, 255.0) as u8)
         });
         let path = a.out.join(format!("{name}.png"));
         ocellus_io::write_png(&path, &out)?;

@@ -84,12 +84,15 @@ pub fn to_image_rgb8(p: &Plane<[u8; 3]>) -> image::RgbImage {
 
 /// A float map as an 8-bit grey `image` buffer, linearly scaled so `lo..hi` maps to 0..255.
 pub fn to_image_gray8(p: &Plane<f32>, lo: f32, hi: f32) -> image::GrayImage {
-    let (w, h) = p.size();
+    let g = to_grey8(p, lo, hi);
+    image::GrayImage::from_fn(g.width() as u32, g.height() as u32, |x, y| image::Luma([g.get(x as usize, y as usize)]))
+}
+
+/// A float map as 8-bit grey: `lo` to 0, `hi` to 255, clamped, rounded; NaN to 0.
+pub fn to_grey8(p: &Plane<f32>, lo: f32, hi: f32) -> Plane<u8> {
     let span = if hi > lo { hi - lo } else { 1.0 };
-    image::GrayImage::from_fn(w as u32, h as u32, |x, y| {
-        let v = (p.get(x as usize, y as usize) - lo) / span;
-        image::Luma([(v.clamp(0.0, 1.0) * 255.0).round() as u8])
-    })
+    // `as u8` of NaN is 0: a NaN pixel comes out black.
+    p.map(|v| (((v - lo) / span).clamp(0.0, 1.0) * 255.0).round() as u8)
 }
 
 /// A grey `image` buffer as a float plane in [0, 1].

@@ -31,6 +31,7 @@ pub mod video_writer;
 pub mod y4m;
 
 use ocellus_image::convert::{from_dynamic, RgbImage};
+use ocellus_image::Plane;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -203,16 +204,44 @@ fn has_jpeg_end(bytes: &[u8]) -> bool {
         || bytes[..end].windows(2).rev().take(64).any(|w| w == [0xff, 0xd9])
 }
 
-/// Writes an `image` buffer as PNG.
-pub fn write_png<P, C>(path: impl AsRef<Path>, img: &image::ImageBuffer<P, C>) -> Result<()>
-where
-    P: image::PixelWithColorType,
-    [P::Subpixel]: image::EncodableLayout,
-    C: std::ops::Deref<Target = [P::Subpixel]>,
-{
+/// The pixels [`write_png`] stores: `u8` as 8-bit grey, `[u8; 3]` as 8-bit RGB.
+pub trait PngPixel: Copy + Default {
+    /// The PNG colour type.
+    const COLOR: image::ExtendedColorType;
+    /// Appends the pixel's bytes.
+    fn extend(self, out: &mut Vec<u8>);
+}
+
+impl PngPixel for u8 {
+    const COLOR: image::ExtendedColorType = image::ExtendedColorType::L8;
+    fn extend(self, out: &mut Vec<u8>) {
+        out.push(self);
+    }
+}
+
+impl PngPixel for [u8; 3] {
+    const COLOR: image::ExtendedColorType = image::ExtendedColorType::Rgb8;
+    fn extend(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self);
+    }
+}
+
+/// Writes a plane of grey (`u8`) or RGB (`[u8; 3]`) pixels as PNG, rows top to bottom.
+/// (`ocellus_image::convert::to_grey8` makes 8-bit grey of a float map.)
+pub fn write_png<P: PngPixel>(path: impl AsRef<Path>, img: &Plane<P>) -> Result<()> {
     let path = path.as_ref();
-    img.save_with_format(path, image::ImageFormat::Png).map_err(|e| match e {
-        image::ImageError::IoError(source) => IoError::Io { path: path.into(), source },
-        other => IoError::Invalid { path: path.into(), reason: other.to_string() },
+    let (w, h) = img.size();
+    if w == 0 || h == 0 || w > u32::MAX as usize || h > u32::MAX as usize {
+        return Err(IoError::Invalid { path: path.into(), reason: format!("cannot write a {w}x{h} image") });
+    }
+    let mut bytes = Vec::with_capacity(w * h * std::mem::size_of::<P>());
+    for y in 0..h {
+        img.row(y).iter().for_each(|p| p.extend(&mut bytes));
+    }
+    image::save_buffer_with_format(path, &bytes, w as u32, h as u32, P::COLOR, image::ImageFormat::Png).map_err(|e| {
+        match e {
+            image::ImageError::IoError(source) => IoError::Io { path: path.into(), source },
+            other => IoError::Invalid { path: path.into(), reason: other.to_string() },
+        }
     })
 }

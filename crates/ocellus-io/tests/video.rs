@@ -2,7 +2,7 @@
 //! ffmpeg's), and other containers through the ffmpeg program (installed by scripts/setup.sh).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
-use ocellus_image::convert::{to_image_rgb8, RgbImage};
+use ocellus_image::convert::RgbImage;
 use ocellus_io::video::Frames;
 use ocellus_io::y4m::Y4mWriter;
 use ocellus_synth::attention_scenes::{Scenario, SceneConfig, SceneGenerator};
@@ -29,7 +29,7 @@ fn frames() -> Vec<RgbImage> {
 
 fn write_pngs(frames: &[RgbImage], dir: &Path) {
     for (k, f) in frames.iter().enumerate() {
-        ocellus_io::write_png(dir.join(format!("f{k}.png")), &to_image_rgb8(&f.to_u8())).unwrap();
+        ocellus_io::write_png(dir.join(format!("f{k}.png")), &f.to_u8()).unwrap();
     }
 }
 
