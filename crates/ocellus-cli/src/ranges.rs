@@ -10,21 +10,33 @@
 use std::fmt::Display;
 use std::str::FromStr;
 
+/// A parser of numbers accepted by `keep`; `range` says which in the error.
+fn number<T>(
+    keep: impl Fn(T) -> bool + Clone + Send + Sync + 'static,
+    range: String,
+) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static
+where
+    T: FromStr + Display + Copy + Send + Sync + 'static,
+    T::Err: Display,
+{
+    move |s: &str| {
+        let v: T = s.trim().parse().map_err(|e| format!("`{s}` is not a number ({e})"))?;
+        // NaN fails every comparison, so it is refused by any range.
+        if keep(v) {
+            Ok(v)
+        } else {
+            Err(format!("{s} is outside the range {range}"))
+        }
+    }
+}
+
 /// A parser of a number in `[lo, hi]` (both ends included).
 pub fn within<T>(lo: T, hi: T) -> impl Fn(&str) -> Result<T, String> + Clone + Send + Sync + 'static
 where
     T: FromStr + PartialOrd + Display + Copy + Send + Sync + 'static,
     T::Err: Display,
 {
-    move |s: &str| {
-        let v: T = s.trim().parse().map_err(|e| format!("`{s}` is not a number ({e})"))?;
-        // NaN fails both comparisons, so it is refused here too.
-        if v >= lo && v <= hi {
-            Ok(v)
-        } else {
-            Err(format!("{s} is outside the range {lo}..={hi}"))
-        }
-    }
+    number(move |v| v >= lo && v <= hi, format!("{lo}..={hi}"))
 }
 
 /// A parser of a number in `(lo, hi]`: above `lo`, at most `hi`.
@@ -33,14 +45,7 @@ where
     T: FromStr + PartialOrd + Display + Copy + Send + Sync + 'static,
     T::Err: Display,
 {
-    move |s: &str| {
-        let v: T = s.trim().parse().map_err(|e| format!("`{s}` is not a number ({e})"))?;
-        if v > lo && v <= hi {
-            Ok(v)
-        } else {
-            Err(format!("{s} is outside the range: it must be above {lo} and at most {hi}"))
-        }
-    }
+    number(move |v| v > lo && v <= hi, format!("({lo}, {hi}] (above {lo}, at most {hi})"))
 }
 
 /// A parser of a point `X,Y` of two finite numbers (pixels).
