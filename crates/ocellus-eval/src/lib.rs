@@ -22,6 +22,9 @@ use thiserror::Error;
 /// Errors of the evaluation crate.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum EvalError {
+    /// An image operation failed (the cause, for matching).
+    #[error(transparent)]
+    Image(#[from] ocellus_image::ImageError),
     /// Two maps that must have the same size do not.
     #[error("size mismatch: {what} is {got_w}x{got_h}, expected {want_w}x{want_h}")]
     SizeMismatch {

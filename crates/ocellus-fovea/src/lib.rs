@@ -38,6 +38,9 @@ use thiserror::Error;
 /// Errors of the fovea crate.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum FoveaError {
+    /// An image operation failed (the cause, for matching).
+    #[error(transparent)]
+    Image(#[from] ocellus_image::ImageError),
     /// A parameter is out of range.
     #[error("invalid log-polar parameter: {0}")]
     Invalid(String),

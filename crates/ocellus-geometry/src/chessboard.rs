@@ -154,8 +154,8 @@ pub fn saddles(img: &Plane<f32>, opts: &ChessboardOptions) -> Result<Vec<Saddle>
     if !img.all_finite() {
         return Err(GeometryError::Invalid("image has non-finite pixels".into()));
     }
-    let smooth = gaussian_blur(img, opts.smoothing_sigma_px).map_err(|e| GeometryError::Invalid(e.to_string()))?;
-    let fine = gaussian_blur(img, 1.0).map_err(|e| GeometryError::Invalid(e.to_string()))?;
+    let smooth = gaussian_blur(img, opts.smoothing_sigma_px)?;
+    let fine = gaussian_blur(img, 1.0)?;
     let (lo, hi) = smooth.min_max();
     let min_contrast = opts.min_contrast_frac * (hi - lo);
     let mut resp = Plane::<f32>::new(w, h);

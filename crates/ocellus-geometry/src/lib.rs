@@ -47,6 +47,9 @@ use thiserror::Error;
 /// Errors of the geometry crate.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum GeometryError {
+    /// An image operation failed (the cause, for matching).
+    #[error(transparent)]
+    Image(#[from] ocellus_image::ImageError),
     /// Too few correspondences.
     #[error("{what} needs at least {need} points, got {got}")]
     TooFewPoints {

@@ -34,6 +34,9 @@ use thiserror::Error;
 /// Errors of the odometry crate.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum OdometryError {
+    /// An image operation failed (the cause, for matching).
+    #[error(transparent)]
+    Image(#[from] ocellus_image::ImageError),
     /// A parameter is out of range.
     #[error("invalid odometry parameter: {0}")]
     Invalid(String),

@@ -37,6 +37,9 @@ use thiserror::Error;
 /// Errors of the generators.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SynthError {
+    /// An image operation failed (the cause, for matching).
+    #[error(transparent)]
+    Image(#[from] ocellus_image::ImageError),
     /// A parameter is out of range.
     #[error("invalid scene configuration: {0}")]
     InvalidConfig(String),
