@@ -316,6 +316,22 @@ impl SaliencyEngine {
     }
 
     /// Computes the saliency map of `frame`; returns it at the map level.
+    ///
+    /// ```
+    /// use ocellus_attention::{SaliencyConfig, SaliencyEngine};
+    /// use ocellus_image::{convert::RgbImage, Plane};
+    /// // A dark frame with one bright red square centred near (200, 70).
+    /// let frame = RgbImage::U8(Plane::from_fn(320, 256, |x, y| {
+    ///     if (184..216).contains(&x) && (54..86).contains(&y) { [250, 30, 30] } else { [40, 40, 40] }
+    /// }));
+    /// let mut engine = SaliencyEngine::new(SaliencyConfig::ace2009(), 320, 256)?;
+    /// let map = engine.process(&frame)?;
+    /// assert_eq!(map.size(), (20, 16)); // 1/16 of the frame per side
+    /// let (cx, cy, _) = map.argmax().unwrap();
+    /// // The winning cell covers the square: cells are 16 px, the square spans cells 11..=13, 3..=5.
+    /// assert!((11..=13).contains(&cx) && (3..=5).contains(&cy), "peak at cell ({cx}, {cy})");
+    /// # Ok::<(), ocellus_attention::AttentionError>(())
+    /// ```
     pub fn process(&mut self, frame: &RgbImage) -> Result<&Plane<f32>> {
         self.process_with_maps(frame, &[])
     }

@@ -70,6 +70,17 @@ pub struct RotationScale {
 }
 
 /// Rotation and scale of `b` relative to `a` (grey images of one size, any units).
+///
+/// ```
+/// use ocellus_fovea::register::{register, warp_similarity, RegisterOptions};
+/// // A photograph, and the same turned by 30 degrees and enlarged 1.2 times about its centre.
+/// let photo = ocellus_io::read_image(ocellus_testdata::data_file("camera.png"))?;
+/// let a = photo.to_luma8().map(|v| v as f32);
+/// let b = warp_similarity(&a, 30f64.to_radians(), 1.2);
+/// let r = register(&a, &b, &RegisterOptions::default())?;
+/// assert!((r.angle_deg - 30.0).abs() < 0.5 && (r.scale - 1.2).abs() < 0.01, "{r:?}");
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn register(a: &Plane<f32>, b: &Plane<f32>, opts: &RegisterOptions) -> Result<RotationScale> {
     if a.size() != b.size() {
         return Err(FoveaError::Size { got_w: b.width(), got_h: b.height(), want_w: a.width(), want_h: a.height() });

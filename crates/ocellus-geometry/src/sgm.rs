@@ -474,6 +474,19 @@ impl SgmMatcher {
 }
 
 /// Disparity of the left image by SGM (allocating; see [`SgmMatcher`] for streams).
+///
+/// ```
+/// use ocellus_geometry::sgm::{sgm, Sgm};
+/// use ocellus_image::{rng::SplitMix64, Plane};
+/// // A random texture seen 6 px further left by the right camera: disparity 6 everywhere.
+/// let mut rng = SplitMix64::new(1);
+/// let texture: Vec<u8> = (0..200 * 80).map(|_| (rng.unit() * 255.0) as u8).collect();
+/// let left = Plane::from_vec(200, 80, texture)?;
+/// let right = Plane::from_fn(200, 80, |x, y| left.get((x + 6).min(199), y));
+/// let d = sgm(&left, &right, &Sgm { max_disparity: 16, ..Sgm::default() })?;
+/// assert!((d.get(100, 40) - 6.0).abs() < 0.25, "{}", d.get(100, 40));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn sgm(left: &Plane<u8>, right: &Plane<u8>, p: &Sgm) -> Result<Plane<f32>> {
     p.check(left, right)?;
     let mut m = SgmMatcher::new(*p, left.width(), left.height())?;
