@@ -248,7 +248,10 @@ fn eval(a: &EvalArgs) -> Result<()> {
     let planar = |p: &TumPose| PlanarPose::new(p.time_s, p.position[0], p.position[1], p.yaw());
     let (est_p, gt_p): (Vec<PlanarPose>, Vec<PlanarPose>) =
         (est.iter().map(planar).collect(), gt.iter().map(planar).collect());
-    let e = trajectory::errors(&est_p, &gt_p, a.max_dt)?;
+    // Paired once: the errors and the plot use the same pairs.
+    let index_pairs = trajectory::pair_by_time(&est_p, &gt_p, a.max_dt);
+    let planar_pairs: Vec<(PlanarPose, PlanarPose)> = index_pairs.iter().map(|&(i, j)| (est_p[i], gt_p[j])).collect();
+    let e = trajectory::errors_of_pairs(&planar_pairs)?;
     outln!("{} poses paired, path {:.4} m", e.pairs, e.path_m);
     outln!(
         "final drift {:.4} % of the path, final heading error {:.4} deg",
@@ -256,9 +259,7 @@ fn eval(a: &EvalArgs) -> Result<()> {
         e.final_heading_deg
     );
     outln!("ATE RMSE {:.3} mm, RPE per frame RMSE {:.4} mm", e.ate_rmse_m * 1e3, e.rpe_rmse_m * 1e3);
-    // The plot shows the paired poses of both.
-    let pairs: Vec<(TumPose, TumPose)> =
-        trajectory::pair_by_time(&est_p, &gt_p, a.max_dt).into_iter().map(|(i, j)| (est[i], gt[j])).collect();
+    let pairs: Vec<(TumPose, TumPose)> = index_pairs.into_iter().map(|(i, j)| (est[i], gt[j])).collect();
     let (e, g): (Vec<TumPose>, Vec<TumPose>) = pairs.into_iter().unzip();
     plot_trajectories(&a.plot, &[("ground truth", &g, RGBColor(30, 30, 30)), ("estimate", &e, RGBColor(200, 40, 40))])?;
     outln!("wrote {}", a.plot.display());

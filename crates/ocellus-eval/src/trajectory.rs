@@ -106,10 +106,15 @@ pub struct TrajectoryErrors {
 pub fn errors(estimate: &[PlanarPose], truth: &[PlanarPose], max_dt_s: f64) -> Result<TrajectoryErrors> {
     let pairs: Vec<(PlanarPose, PlanarPose)> =
         pair_by_time(estimate, truth, max_dt_s).into_iter().map(|(i, j)| (estimate[i], truth[j])).collect();
+    errors_of_pairs(&pairs)
+}
+
+/// The errors of `(estimate, truth)` pairs already matched in time (at least two).
+pub fn errors_of_pairs(pairs: &[(PlanarPose, PlanarPose)]) -> Result<TrajectoryErrors> {
     if pairs.len() < 2 {
         return Err(EvalError::Undefined {
             metric: "trajectory errors",
-            why: format!("only {} poses pair up within {max_dt_s} s: do the timestamps match?", pairs.len()),
+            why: format!("only {} poses pair up in time: do the timestamps match?", pairs.len()),
         });
     }
     let (est, gt): (Vec<PlanarPose>, Vec<PlanarPose>) = pairs.iter().copied().unzip();
