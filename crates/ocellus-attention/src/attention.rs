@@ -18,6 +18,7 @@
 
 use crate::egosphere::{separation_deg, BlobField, Egosphere, ViewGeometry};
 use crate::{AttentionError, Result};
+use ocellus_image::location::cell_centre;
 use ocellus_image::Plane;
 use serde::{Deserialize, Serialize};
 
@@ -243,8 +244,8 @@ impl Attention {
         // Map cell centres in full-frame pixels and on the sphere (azimuth depends on the
         // column only, elevation on the row only, in the equiangular model).
         let (mw, mh) = saliency.size();
-        let (sx, sy) = (self.view.width as f32 / mw as f32, self.view.height as f32 / mh as f32);
-        let pixel = |x: usize, y: usize| ((x as f32 + 0.5) * sx - 0.5, (y as f32 + 0.5) * sy - 0.5);
+        let (vw, vh) = (self.view.width, self.view.height);
+        let pixel = |x: usize, y: usize| (cell_centre(x, mw, vw) as f32, cell_centre(y, mh, vh) as f32);
         self.col_az.clear();
         self.col_az.extend((0..mw).map(|x| self.view.direction(pixel(x, 0).0, 0.0, pan_deg, tilt_deg).0));
         self.row_el.clear();

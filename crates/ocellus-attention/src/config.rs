@@ -335,6 +335,21 @@ impl SaliencyConfig {
         self.center_levels.iter().copied().min().unwrap_or(0).min(self.map_level)
     }
 
+    /// This configuration with every `kind` channel replaced by one of `weight` (none for a
+    /// weight of 0), checked: e.g. the skin channel of the evaluation mode.
+    pub fn with_channel_weight(&self, kind: ChannelKind, weight: f32) -> Result<SaliencyConfig> {
+        if !weight.is_finite() || weight < 0.0 {
+            return Err(AttentionError::InvalidConfig(format!("{kind:?} channel weight must be >= 0, got {weight}")));
+        }
+        let mut c = self.clone();
+        c.channels.retain(|ch| ch.kind != kind);
+        if weight > 0.0 {
+            c.channels.push(ChannelConfig { kind, weight });
+        }
+        c.validate()?;
+        Ok(c)
+    }
+
     /// Checks every parameter; the message names the offending one.
     pub fn validate(&self) -> Result<()> {
         let bad = |m: String| Err(AttentionError::InvalidConfig(m));

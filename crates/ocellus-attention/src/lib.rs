@@ -21,7 +21,6 @@
 //! ```
 
 pub mod attention;
-pub mod center_prior;
 pub mod center_surround;
 pub mod channels;
 pub mod chaos;

@@ -308,7 +308,7 @@ impl SaliencyEngine {
                 }
                 let (w, h) = self.map_size();
                 let mut out = Plane::default();
-                Resampler::new(ResampleMethod::Bilinear, p.size(), (w, h))?.apply(p, &mut out)?;
+                Resampler::new(ResampleMethod::Bilinear, p.size(), (w, h))?.apply(self.backend, p, &mut out)?;
                 Some(out)
             }
         };
@@ -464,7 +464,7 @@ impl SaliencyEngine {
                     Some(Resampler::new(ResampleMethod::Bilinear, m.size(), self.sizes[base])?);
             }
             if let Some(rs) = &self.external_resamplers[k] {
-                rs.apply_with(m, &mut self.pyr.external[k][base], &mut self.resample_row)?;
+                rs.apply_with(b, m, &mut self.pyr.external[k][base], &mut self.resample_row)?;
             }
             Self::pyramid_up(b, &mut self.pyr.external[k], base, top, &cfg.pyramid, &mut self.pyr_scratch)?;
         }
@@ -523,7 +523,7 @@ impl SaliencyEngine {
             for &l in &self.used_levels {
                 let Some(plane) = self.pyr.get(src, l) else { continue };
                 if let Some(r) = &self.resamplers[l] {
-                    r.apply_with(plane, &mut self.rescaled[s][l], &mut self.resample_row)?;
+                    r.apply_with(self.backend, plane, &mut self.rescaled[s][l], &mut self.resample_row)?;
                 }
             }
         }
@@ -655,7 +655,7 @@ impl SaliencyEngine {
                 Some(Resampler::new(ResampleMethod::Bilinear, self.map_size(), (self.width, self.height))?);
         }
         if let Some(up) = &self.upsampler {
-            up.apply_with(&self.saliency, out, &mut self.resample_row)?;
+            up.apply_with(self.backend, &self.saliency, out, &mut self.resample_row)?;
         }
         Ok(())
     }

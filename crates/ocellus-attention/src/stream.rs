@@ -136,6 +136,20 @@ impl StreamEngine {
         &self.chaos
     }
 
+    /// The surprise map of the last frame, bits (map level).
+    pub fn surprise_map(&self) -> &Plane<f32> {
+        self.surprise.map()
+    }
+
+    /// Forgets the previous frames of flicker, surprise and chaos, as after a jump of the
+    /// camera (a new burst); attention's memory (habituation, inhibition, ego-sphere) and the
+    /// frame count stay.
+    pub fn reset_temporal(&mut self) {
+        self.saliency.reset_temporal();
+        self.surprise.reset();
+        self.chaos.reset();
+    }
+
     /// Processes one frame seen by a camera at (`pan_deg`, `tilt_deg`).
     pub fn process(&mut self, frame: &RgbImage, pan_deg: f32, tilt_deg: f32) -> Result<StreamFrame<'_>> {
         let t0 = Instant::now();

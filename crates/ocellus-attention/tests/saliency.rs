@@ -20,7 +20,7 @@ fn grey_level(name: &str, levels: usize) -> Plane<f32> {
         (c[0] + c[1] + c[2]) / 3.0
     });
     for _ in 0..levels {
-        p = pyr_down_alloc(&p, &ocellus_image::pyramid::PyramidKernel::itti()).unwrap();
+        p = pyr_down_alloc(Backend::Scalar, &p, &ocellus_image::pyramid::PyramidKernel::itti()).unwrap();
     }
     p
 }

@@ -14,3 +14,14 @@ pub const TEXTURES: &[(&str, &[u8])] = &[
     ("gravel.png", include_bytes!("../../../assets/gravel.png")),
     ("grass.png", include_bytes!("../../../assets/grass.png")),
 ];
+
+/// A built-in image or texture, decoded.
+pub fn decode(name: &str) -> anyhow::Result<ocellus_image::convert::RgbImage> {
+    let bytes = IMAGES
+        .iter()
+        .chain(TEXTURES)
+        .find(|(n, _)| *n == name)
+        .map(|(_, b)| *b)
+        .ok_or_else(|| anyhow::anyhow!("no built-in image {name}"))?;
+    Ok(ocellus_io::decode_image(bytes, std::path::Path::new(name))?)
+}

@@ -1,13 +1,16 @@
 //! `ocellus attend`: saliency, surprise, context chaos and attention over a video or image
 //! sequence, with overlays, a scanpath and per-frame context values.
 
-use crate::{config_file, frames, overlay, plot, ranges};
+use crate::{config_file, frames, plot, ranges};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ocellus_attention::attention::{Fixation, Reason};
 use ocellus_attention::stream::{StreamConfig, StreamEngine, StreamFrame};
 use ocellus_attention::surprise::SurpriseConfig;
+use ocellus_image::colormap::overlay_scaled;
 use ocellus_image::convert::RgbImage;
+use ocellus_image::draw;
+use ocellus_image::Backend;
 use ocellus_image::Plane;
 use ocellus_io::video_writer::VideoWriter;
 use plotters::style::RGBColor;
@@ -207,25 +210,25 @@ impl Outputs {
 /// panel at half the frame size (even sizes, for video).
 fn composite(frame: &RgbImage, r: &StreamFrame, recent: &[Fixation]) -> Result<Plane<[u8; 3]>> {
     let px = frame.to_u8();
-    let mut half = overlay::half_size(&px);
+    let mut half = draw::half_size(&px);
     let (w, h) = (half.width() & !1, half.height() & !1);
     half = Plane::from_fn(w.max(2), h.max(2), |x, y| half.get(x.min(half.width() - 1), y.min(half.height() - 1)));
-    let sal = overlay::overlay_scaled(&half, r.saliency, 0.0)?;
+    let sal = overlay_scaled(Backend::Auto, &half, r.saliency, 0.0)?;
     // Surprise on a fixed scale up to 10 bits, so quiet frames look quiet.
-    let sur = overlay::overlay_scaled(&half, r.surprise, 10.0)?;
-    let inh = overlay::overlay_scaled(&half, r.inhibition, 1.0)?;
+    let sur = overlay_scaled(Backend::Auto, &half, r.surprise, 10.0)?;
+    let inh = overlay_scaled(Backend::Auto, &half, r.inhibition, 1.0)?;
     let mut view = half.clone();
     for f in recent {
-        overlay::draw_ring(&mut view, f.x / 2.0, f.y / 2.0, 6.0, [255, 255, 255]);
+        draw::ring(&mut view, (f.x - 0.5) / 2.0, (f.y - 0.5) / 2.0, 6.0, [255, 255, 255]);
     }
     if let Some(f) = r.fixation {
         let color = match f.reason {
             Reason::Salient => [40, 230, 60],
             Reason::Surprising => [250, 40, 40],
         };
-        overlay::draw_ring(&mut view, f.x / 2.0, f.y / 2.0, 14.0, color);
+        draw::ring(&mut view, (f.x - 0.5) / 2.0, (f.y - 0.5) / 2.0, 14.0, color);
     }
-    Ok(overlay::grid2x2([&view, &sal, &sur, &inh]))
+    Ok(draw::grid2x2([&view, &sal, &sur, &inh]))
 }
 
 /// Runs the subcommand.

@@ -12,9 +12,7 @@ use std::time::Instant;
 /// The built-in astronaut photo stretched to 640x480 (nearest pixel: the content only has
 /// to be a real image; the timing does not depend on it).
 fn frame() -> Result<Plane<[u8; 3]>> {
-    let (name, bytes) =
-        crate::assets::IMAGES.iter().find(|(n, _)| *n == "astronaut.png").context("built-in astronaut.png missing")?;
-    let src = ocellus_io::decode_image(bytes, std::path::Path::new(name))?.to_u8();
+    let src = crate::assets::decode("astronaut.png")?.to_u8();
     let (w, h) = src.size();
     Ok(Plane::from_fn(640, 480, |x, y| src.get(x * w / 640, y * h / 480)))
 }
@@ -35,7 +33,7 @@ pub fn run(json_out: bool) -> Result<()> {
         }
         let map = map.context("no map")?;
         let mut scratch = Scratch::default();
-        let (mut out, mut out_rgb) = (Plane::default(), Vec::new());
+        let (mut out, mut out_rgb) = (Plane::default(), <[Plane<f32>; 3]>::default());
         let (mut tg, mut tc) = (Vec::new(), Vec::new());
         for _ in 0..400 {
             let t = Instant::now();
@@ -57,10 +55,8 @@ pub fn run(json_out: bool) -> Result<()> {
     }
     // Registration of a 512x512 photo with a turned and scaled copy, and vergence over 65
     // disparities on a pair made by shifting it 20 px.
-    let (name, bytes) =
-        crate::assets::IMAGES.iter().find(|(n, _)| *n == "astronaut.png").context("built-in astronaut.png missing")?;
-    let photo = ocellus_io::decode_image(bytes, std::path::Path::new(name))?.to_luma8();
-    let a = photo.map(|v| v as f32);
+    let decoded = crate::assets::decode("astronaut.png")?;
+    let (photo, a) = (decoded.to_luma8(), decoded.to_grey());
     let b = ocellus_fovea::register::warp_similarity(&a, 0.5, 1.3);
     for (key, mode) in [("ms_register_direct_512", Mode::Direct), ("ms_register_spectrum_512", Mode::Spectrum)] {
         let mut t = Vec::new();

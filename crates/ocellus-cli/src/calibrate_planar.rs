@@ -2,13 +2,13 @@
 //! images of a chessboard or from given planar correspondences.
 
 use crate::inputs::{check_out_dir, collect_images, output_stems, stem};
-use crate::overlay::draw_ring;
 use crate::plot::{self, Plot, Series};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ocellus_geometry::camera_file::{self, CameraFile};
 use ocellus_geometry::chessboard::{find_chessboard, ChessboardOptions};
 use ocellus_geometry::zhang::{calibrate, project_view, PlanarCalibration, PlanarView, ZhangOptions};
+use ocellus_image::draw::ring as draw_ring;
 use ocellus_image::Plane;
 use rayon::prelude::*;
 use serde_json::json;
@@ -116,7 +116,7 @@ pub fn parse_length_mm(s: &str) -> Result<f64> {
 type Detection = (Plane<[u8; 3]>, std::result::Result<Vec<[f64; 2]>, String>);
 
 fn grey(img: &ocellus_image::convert::RgbImage) -> Plane<f32> {
-    img.to_luma8().map(|v| v as f32 / 255.0)
+    img.to_grey()
 }
 
 /// Runs `calibrate chessboard`.

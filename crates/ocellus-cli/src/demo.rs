@@ -44,8 +44,8 @@ pub fn run(a: DemoArgs) -> Result<()> {
                 inputs::stem(&path),
                 r.map_size.0,
                 r.map_size.1,
-                r.peak_px.0,
-                r.peak_px.1,
+                r.peak_px[0],
+                r.peak_px[1],
                 t,
                 r.files.len()
             );
@@ -58,12 +58,10 @@ pub fn run(a: DemoArgs) -> Result<()> {
     outln!("ocellus demo: log-polar images fixating the most salient point of each image");
     let fov = dir.join("logpolar");
     crate::output_files::create_dir(&fov)?;
-    for (path, (px, py)) in &peaks {
+    for (path, [px, py]) in &peaks {
         let img = crate::budget::read_image(path)?.to_u8();
         let (w, h) = img.size();
-        // The saliency peak is in edge coordinates (pixel centres at +0.5); the map puts
-        // pixel centres at integers.
-        let cfg = LogPolarConfig { centre: [*px as f64 - 0.5, *py as f64 - 0.5], ..LogPolarConfig::for_image(w, h) };
+        let cfg = LogPolarConfig { centre: [*px, *py], ..LogPolarConfig::for_image(w, h) };
         let map = LogPolarMap::new(&cfg, w, h)?;
         let stem = inputs::stem(path);
         let (c, i) = (fov.join(format!("{stem}.cortex.png")), fov.join(format!("{stem}.inverse.png")));

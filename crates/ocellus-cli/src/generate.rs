@@ -2,9 +2,8 @@
 
 use crate::assets;
 use crate::ranges;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, Subcommand, ValueEnum};
-use ocellus_image::convert::RgbImage;
 use ocellus_io::y4m::Y4mWriter;
 use ocellus_synth::attention_scenes::{Scenario, SceneConfig, SceneGenerator};
 use std::io::Write;
@@ -68,10 +67,7 @@ struct AttentionArgs {
 
 /// Coffee, rocket and astronaut side by side as the world; the cat as the sudden object.
 pub fn scene(cfg: SceneConfig) -> Result<SceneGenerator> {
-    let img = |name: &str| -> Result<RgbImage> {
-        let bytes = assets::IMAGES.iter().find(|(n, _)| *n == name).map(|(_, b)| *b).context("missing asset")?;
-        Ok(ocellus_io::decode_image(bytes, Path::new(name))?)
-    };
+    let img = assets::decode;
     let world = [img("coffee.png")?, img("rocket.jpg")?, img("astronaut.png")?];
     Ok(SceneGenerator::new(cfg, &world, &img("chelsea.png")?)?)
 }

@@ -13,7 +13,7 @@ use ocellus_image::resample::{resize, ResampleMethod};
 use ocellus_image::rng::SplitMix64;
 use ocellus_synth::chessboard::{Board, BoardCamera};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `ocellus generate chessboard`.
 #[derive(Args, Debug)]
@@ -64,9 +64,8 @@ pub fn run(a: ChessboardArgs) -> Result<()> {
     };
     let [w, h] = truth.image_size.context("the camera file needs image_size = [width, height] to render")?;
     let cam = BoardCamera::new(truth.intrinsics, truth.distortion, w, h)?;
-    let bytes = assets::IMAGES.iter().find(|(n, _)| *n == "coffee.png").map(|(_, b)| *b).context("missing asset")?;
-    let photo = ocellus_io::decode_image(bytes, Path::new("coffee.png"))?.to_luma8().map(|v| v as f32 / 255.0);
-    let background = resize(&photo, w, h, ResampleMethod::Bilinear)?;
+    let photo = assets::decode("coffee.png")?.to_grey();
+    let background = resize(ocellus_image::Backend::Auto, &photo, w, h, ResampleMethod::Bilinear)?;
     crate::output_files::create_dir(&a.out)?;
     camera_file::write(&a.out.join("camera_truth.toml"), &truth)?;
     let csv_path = a.out.join("corners_truth.csv");

@@ -11,7 +11,7 @@ use ocellus_io::tum::TumPose;
 use ocellus_io::y4m::Y4mWriter;
 use ocellus_synth::ground::{encoders, GroundConfig, GroundScene, GroundTexture};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Floor texture.
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -52,12 +52,9 @@ pub struct GroundArgs {
     out: PathBuf,
 }
 
-/// The floor textures (brick, grass, gravel) of the built-in assets, grey 0..255.
+/// The floor textures (brick, grass, gravel) of the built-in assets, grey in [0, 1].
 pub fn textures() -> Result<[Plane<f32>; 3]> {
-    let load = |name: &str| -> Result<Plane<f32>> {
-        let bytes = assets::TEXTURES.iter().find(|(n, _)| *n == name).map(|(_, b)| *b).context("missing texture")?;
-        Ok(ocellus_io::decode_image(bytes, Path::new(name))?.to_luma8().map(|v| v as f32))
-    };
+    let load = |name: &str| -> Result<Plane<f32>> { Ok(assets::decode(name)?.to_grey()) };
     Ok([load("brick.png")?, load("grass.png")?, load("gravel.png")?])
 }
 

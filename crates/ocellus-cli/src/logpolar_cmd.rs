@@ -9,6 +9,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use ocellus_fovea::logpolar::{Fields, LogPolarConfig, LogPolarMap, Scratch};
 use ocellus_fovea::register::{register, Mode, RegisterOptions};
 use ocellus_fovea::vergence::{vergence, VergenceOptions};
+use ocellus_image::convert::merge_rgb8;
 use ocellus_image::Plane;
 use ocellus_io::video_writer::VideoWriter;
 use std::path::{Path, PathBuf};
@@ -109,7 +110,7 @@ struct VergenceArgs {
 }
 
 fn grey_f32(path: &Path) -> Result<Plane<f32>> {
-    Ok(crate::budget::read_image(path)?.to_luma8().map(|v| v as f32))
+    Ok(crate::budget::read_image(path)?.to_grey())
 }
 
 /// Runs the subcommand.
@@ -178,12 +179,6 @@ fn config(a: &LogPolarArgs, w: usize, h: usize) -> LogPolarConfig {
     cfg
 }
 
-/// 8-bit RGB from three float planes (rounded, saturated).
-fn to_rgb8(p: [&Plane<f32>; 3]) -> Plane<[u8; 3]> {
-    let (pw, ph) = p[0].size();
-    Plane::from_fn(pw, ph, |x, y| p.map(|c| c.get(x, y).round().clamp(0.0, 255.0) as u8))
-}
-
 /// A folder of images, a Y4M file or a video: every frame through one map (built from the
 /// first frame's size); the cortical frames as PNG files, and as videos with their inverses
 /// when ffmpeg is installed.
@@ -197,7 +192,7 @@ fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
         ocellus_io::video_writer::check_output(&a.out.join(v))?;
     }
     let mut state: Option<(LogPolarMap, Scratch, Option<VideoWriter>, Option<VideoWriter>)> = None;
-    let (mut out, mut spent) = (Vec::new(), Vec::new());
+    let (mut out, mut spent) = (<[Plane<f32>; 3]>::default(), Vec::new());
     let n = for_each_frame(input, None, |k, frame| {
         let rgb = frame.to_u8();
         let (w, h) = rgb.size();
@@ -215,13 +210,8 @@ fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
         let t = std::time::Instant::now();
         map.sample_rgb_into(&rgb, scratch, &mut out)?;
         spent.push(t.elapsed().as_secs_f64() * 1e6);
-        let cells = map.rows() * map.sectors();
-        let planes: Vec<Plane<f32>> = out
-            .chunks_exact(cells)
-            .map(|c| Plane::from_vec(map.sectors(), map.rows(), c.to_vec()))
-            .collect::<std::result::Result<_, _>>()?;
-        let [r, g, b] = [&planes[0], &planes[1], &planes[2]];
-        let cortex = to_rgb8([r, g, b]);
+        let [r, g, b] = &out;
+        let cortex = merge_rgb8([r, g, b]);
         ocellus_io::write_png(cortex_dir.join(format!("{k:05}.png")), &cortex)?;
         let even = |p: &Plane<[u8; 3]>| {
             let (pw, ph) = p.size();
@@ -231,7 +221,7 @@ fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
             v.write(&even(&cortex))?;
         }
         if let Some(v) = inverse_video.as_mut() {
-            let inverse = to_rgb8([&map.inverse(r)?, &map.inverse(g)?, &map.inverse(b)?]);
+            let inverse = merge_rgb8([&map.inverse(r)?, &map.inverse(g)?, &map.inverse(b)?]);
             v.write(&even(&inverse))?;
         }
         Ok(())
@@ -266,9 +256,9 @@ fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
 /// Writes the cortical image of `rgb` under `map` and its inverse as PNG files.
 pub fn write_foveated(map: &LogPolarMap, rgb: &Plane<[u8; 3]>, cortex_png: &Path, inverse_png: &Path) -> Result<()> {
     let [r, g, b] = map.sample_rgb(rgb)?;
-    ocellus_io::write_png(cortex_png, &to_rgb8([&r, &g, &b]))?;
+    ocellus_io::write_png(cortex_png, &merge_rgb8([&r, &g, &b]))?;
     let (ir, ig, ib) = (map.inverse(&r)?, map.inverse(&g)?, map.inverse(&b)?);
-    ocellus_io::write_png(inverse_png, &to_rgb8([&ir, &ig, &ib]))?;
+    ocellus_io::write_png(inverse_png, &merge_rgb8([&ir, &ig, &ib]))?;
     Ok(())
 }
 

@@ -16,7 +16,6 @@ mod calibrate_cmd;
 mod calibrate_planar;
 
 mod config_file;
-mod corridor_sim;
 mod demo;
 mod eval;
 mod frames;
@@ -27,7 +26,6 @@ mod inputs;
 mod logpolar_cmd;
 mod odometry_cmd;
 mod output_files;
-mod overlay;
 mod plan_cmd;
 mod plot;
 mod ranges;

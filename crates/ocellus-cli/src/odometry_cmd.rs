@@ -9,7 +9,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use ocellus_eval::trajectory::{self, PlanarPose};
 use ocellus_geometry::camera_file;
 use ocellus_geometry::distortion::{remap_bilinear, undistort_maps};
-use ocellus_image::Plane;
+use ocellus_image::{draw, Plane};
 use ocellus_io::tum::TumPose;
 use ocellus_odometry::fusion::{encoder_motion, EncoderReading, Fusion, FusionConfig};
 use ocellus_odometry::kinematics::Mount;
@@ -202,19 +202,8 @@ fn write_flow(path: &Path, grey: &Plane<u8>, flows: &[ocellus_odometry::sad_flow
     let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
     for f in flows {
         let (x0, y0) = (f.u + cx, f.v + cy);
-        for s in 0..=50 {
-            let t = s as f64 / 50.0 * 5.0;
-            let (x, y) = ((x0 + t * f.du).round(), (y0 + t * f.dv).round());
-            if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
-                img.set(x as usize, y as usize, [0, 230, 0]);
-            }
-        }
-        for (dx, dy) in [(0i64, 0i64), (1, 0), (-1, 0), (0, 1), (0, -1)] {
-            let (x, y) = (x0.round() as i64 + dx, y0.round() as i64 + dy);
-            if x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
-                img.set(x as usize, y as usize, [230, 0, 0]);
-            }
-        }
+        draw::line(&mut img, [x0, y0], [x0 + 5.0 * f.du, y0 + 5.0 * f.dv], [0, 230, 0]);
+        draw::dot(&mut img, [x0, y0], [230, 0, 0]);
     }
     Ok(ocellus_io::write_png(path, &img)?)
 }

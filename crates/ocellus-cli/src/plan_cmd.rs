@@ -1,10 +1,10 @@
 //! `ocellus plan corridor`: the view-planning experiment, with frames, a CSV and plots.
 
-use crate::corridor_sim::{self, RunConfig, StepRecord};
-use crate::{overlay, plot};
+use crate::plot;
 use anyhow::Result;
 use clap::{Args, Subcommand};
 use ocellus_image::Plane;
+use ocellus_sim::corridor_experiment::{self as corridor_sim, CorridorImages, RunConfig, StepRecord};
 use ocellus_synth::corridor::Corridor;
 use plotters::style::RGBColor;
 use std::io::Write;
@@ -49,7 +49,7 @@ fn annotate(world: &Corridor, r: &StepRecord, frame: &ocellus_image::convert::Rg
     for (lx, ly) in world.landmarks() {
         let b = (ly - r.true_xy.1).atan2(lx - r.true_xy.0).to_degrees();
         if let Some(u) = world.column_of(b, r.pan_deg) {
-            overlay::draw_ring(&mut img, u as f32, row, 18.0, [255, 230, 0]);
+            ocellus_image::draw::ring(&mut img, u as f32, row, 18.0, [255, 230, 0]);
         }
     }
     let color = if r.decision.v >= 0.5 { [40, 230, 60] } else { [250, 40, 40] };
@@ -106,14 +106,27 @@ fn angles(records: &[StepRecord]) -> Vec<(f64, f64)> {
     records.iter().map(|r| (r.step as f64, r.decision.pan_deg)).collect()
 }
 
+/// The corridor's photographs and textures from the built-in assets.
+fn corridor_images() -> Result<CorridorImages> {
+    let read = crate::assets::decode;
+    Ok(CorridorImages {
+        astronaut: read("astronaut.png")?,
+        brick: read("brick.png")?,
+        gravel: read("gravel.png")?,
+        coffee: read("coffee.png")?,
+        rocket: read("rocket.jpg")?,
+        chelsea: read("chelsea.png")?,
+    })
+}
+
 /// Runs the subcommand.
 pub fn run(a: PlanArgs) -> Result<()> {
     let What::Corridor(a) = a.what;
-    let world = corridor_sim::corridor()?;
+    let world = corridor_sim::corridor(&corridor_images()?)?;
     let cfg = RunConfig { steps: a.steps, event: a.event, seed: a.seed, ..RunConfig::default() };
     let frames = a.out.join("frames");
     crate::output_files::create_dir(&frames)?;
-    let records = corridor_sim::run(&cfg, &world, |r, frame| {
+    let records = corridor_sim::run(&cfg, &world, |r, frame| -> Result<()> {
         let path = frames.join(format!("step_{:02}.png", r.step));
         Ok(ocellus_io::write_png(path, &annotate(&world, r, frame))?)
     })?;
@@ -125,7 +138,7 @@ pub fn run(a: PlanArgs) -> Result<()> {
         color: RGBColor(200, 40, 40),
     }];
     let baseline = if a.event {
-        Some(corridor_sim::run(&RunConfig { event: false, ..cfg.clone() }, &world, |_, _| Ok(()))?)
+        Some(corridor_sim::run(&RunConfig { event: false, ..cfg.clone() }, &world, |_, _| -> Result<()> { Ok(()) })?)
     } else {
         None
     };

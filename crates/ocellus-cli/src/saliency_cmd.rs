@@ -1,6 +1,6 @@
 //! `ocellus saliency`: saliency maps, overlays and raw values for images and folders.
 
-use crate::{config_file, inputs, overlay};
+use crate::{config_file, inputs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -38,8 +38,8 @@ pub struct SaliencyArgs {
 pub struct SaliencyResult {
     /// Map-level size (w, h).
     pub map_size: (usize, usize),
-    /// Most salient location in input pixels (x, y), centre of the winning map cell.
-    pub peak_px: (f32, f32),
+    /// Most salient location in input pixels (x, y; integer centres), centre of the winning map cell.
+    pub peak_px: [f64; 2],
     /// Files written.
     pub files: Vec<PathBuf>,
 }
@@ -75,7 +75,7 @@ pub fn process_one(
     let mut full = Plane::default();
     e.saliency_full_size(&mut full)?;
     let ov = out.join(format!("{stem}.overlay.png"));
-    ocellus_io::write_png(&ov, &overlay::overlay(&img.to_u8(), &full))?;
+    ocellus_io::write_png(&ov, &ocellus_image::colormap::overlay(&img.to_u8(), &full))?;
     files.push(ov);
     if conspicuity {
         let maps: Vec<(String, Plane<f32>)> =
@@ -85,10 +85,10 @@ pub fn process_one(
         }
     }
     let s = e.saliency();
-    let (mw, mh) = s.size();
-    let (bx, by, _) = s.argmax().unwrap_or((0, 0, 0.0));
-    let peak_px = ((bx as f32 + 0.5) * w as f32 / mw as f32, (by as f32 + 0.5) * h as f32 / mh as f32);
-    Ok(SaliencyResult { map_size: (mw, mh), peak_px, files })
+    let Some(peak) = ocellus_image::location::peak(s, (w, h)) else {
+        bail!("{}: the saliency map is empty", path.display())
+    };
+    Ok(SaliencyResult { map_size: s.size(), peak_px: peak.pixel, files })
 }
 
 /// Runs the subcommand.
@@ -119,12 +119,12 @@ pub fn run(a: SaliencyArgs) -> Result<()> {
             Ok(r) => {
                 bar.suspend(|| -> Result<()> {
                     outln!(
-                        "{}: map {}x{}, most salient at ({:.0}, {:.0}) px",
+                        "{}: map {}x{}, most salient at ({:.1}, {:.1}) px",
                         f.display(),
                         r.map_size.0,
                         r.map_size.1,
-                        r.peak_px.0,
-                        r.peak_px.1
+                        r.peak_px[0],
+                        r.peak_px[1]
                     );
                     if a.timings {
                         if let Some(e) = &engine {

@@ -1,13 +1,11 @@
 //! `ocellus stereo`: dense disparity of a rectified pair (block matching or SGM), depth and a
 //! point cloud.
 
-use crate::overlay;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use ocellus_geometry::block_matching::{bad_pixels, block_match, BlockMatching};
 use ocellus_geometry::sgm::{Sgm, SgmMatcher, SgmPaths};
 use ocellus_geometry::stereo::{depth_and_points, ParallelStereo};
-use ocellus_image::Plane;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -72,18 +70,6 @@ pub enum Method {
     Bm,
     /// Semi-global matching.
     Sgm,
-}
-
-/// Disparity as a heat map (0..max), invalid pixels black.
-fn disparity_image(d: &Plane<f32>, max: f32) -> Plane<[u8; 3]> {
-    Plane::from_fn(d.width(), d.height(), |x, y| {
-        let v = d.get(x, y);
-        if v.is_finite() {
-            overlay::heat_color(v / max)
-        } else {
-            [0, 0, 0]
-        }
-    })
 }
 
 /// Runs the subcommand.
@@ -161,7 +147,7 @@ pub fn run(a: StereoArgs) -> Result<()> {
         }
     };
     crate::output_files::create_dir(&a.out)?;
-    ocellus_io::write_png(a.out.join("disparity.png"), &disparity_image(&disp, a.max_disp as f32))?;
+    ocellus_io::write_png(a.out.join("disparity.png"), &ocellus_image::colormap::heat_map(&disp, a.max_disp as f32))?;
     ocellus_io::pfm::write(a.out.join("disparity.pfm"), &disp)?;
     let valid = disp.to_vec().iter().filter(|v| v.is_finite()).count();
     outln!(

@@ -1,10 +1,12 @@
 //! `ocellus surprise`: Bayesian surprise maps of a video or image sequence.
 
 use crate::attend::StreamOptions;
-use crate::{frames, overlay};
+use crate::frames;
 use anyhow::{bail, Result};
 use clap::Args;
 use ocellus_attention::stream::StreamEngine;
+use ocellus_image::colormap::overlay_scaled;
+use ocellus_image::draw::half_size;
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -47,23 +49,14 @@ pub fn run(a: SurpriseArgs) -> Result<()> {
         let Some(e) = engine.as_mut() else { bail!("no engine") };
         let r = e.process(frame, 0.0, 0.0)?;
         let m = r.surprise;
-        let (mut best, mut at) = (f32::MIN, (0, 0));
-        for y in 0..m.height() {
-            for (x, &v) in m.row(y).iter().enumerate() {
-                if v > best {
-                    (best, at) = (v, (x, y));
-                }
-            }
-        }
-        // Cell centre in frame pixels.
-        let (sx, sy) = (w as f32 / m.width() as f32, h as f32 / m.height() as f32);
-        let (px, py) = ((at.0 as f32 + 0.5) * sx - 0.5, (at.1 as f32 + 0.5) * sy - 0.5);
+        let Some(p) = ocellus_image::location::peak(m, (w, h)) else { bail!("frame {k}: empty surprise map") };
+        let (best, [px, py]) = (p.value, p.pixel);
         let chaos = r.chaos.map(|c| format!("{c:.5}")).unwrap_or_default();
         writeln!(csv, "{k},{best:.4},{px:.1},{py:.1},{chaos}")?;
         if best > peak.0 {
             peak = (best, k);
         }
-        let img = overlay::overlay_scaled(&overlay::half_size(&frame.to_u8()), m, 10.0)?;
+        let img = overlay_scaled(ocellus_image::Backend::Auto, &half_size(&frame.to_u8()), m, 10.0)?;
         ocellus_io::write_png(maps.join(format!("frame_{k:05}.png")), &img)?;
         if a.npy {
             ocellus_io::npy::write_plane(maps.join(format!("frame_{k:05}.npy")), m)?;

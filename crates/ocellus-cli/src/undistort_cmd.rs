@@ -5,6 +5,7 @@ use anyhow::{Context, Result};
 use clap::Args;
 use ocellus_geometry::camera_file;
 use ocellus_geometry::distortion::{remap_bilinear, undistort_maps};
+use ocellus_image::convert::{merge_rgb8, split_rgb8};
 use ocellus_image::Plane;
 use std::path::PathBuf;
 
@@ -47,12 +48,8 @@ pub fn run(a: UndistortArgs) -> Result<()> {
             let (mx, my) = undistort_maps(&cam.intrinsics, &cam.distortion, size.0, size.1);
             (size, mx, my)
         });
-        let channels: Vec<Plane<f32>> = (0..3)
-            .map(|c| remap_bilinear(&img.map(|p| p[c] as f32), &*mx, &*my, 0.0))
-            .collect::<std::result::Result<_, _>>()?;
-        let out = Plane::from_fn(size.0, size.1, |x, y| {
-            std::array::from_fn(|c| channels[c].get(x, y).round().clamp(0.0, 255.0) as u8)
-        });
+        let [r, g, b] = split_rgb8(&img).map(|c| remap_bilinear(&c, &*mx, &*my, 0.0));
+        let out = merge_rgb8([&r?, &g?, &b?]);
         let path = a.out.join(format!("{name}.png"));
         ocellus_io::write_png(&path, &out)?;
     }

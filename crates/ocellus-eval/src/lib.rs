@@ -14,8 +14,11 @@
 //! assert!((sim(&a, &a).unwrap() - 1.0).abs() < 1e-12);
 //! ```
 
+pub mod center_prior;
 pub mod metrics;
+pub mod protocol;
 pub mod trajectory;
+pub mod tuning;
 
 use thiserror::Error;
 
@@ -47,6 +50,9 @@ pub enum EvalError {
         /// Why.
         why: String,
     },
+    /// A parameter of the protocol (blur, centre prior, grid) is out of range.
+    #[error("invalid evaluation parameter: {0}")]
+    InvalidConfig(String),
 }
 
 /// Result type of this crate.

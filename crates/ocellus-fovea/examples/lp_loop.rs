@@ -18,7 +18,7 @@ fn main() {
     let build = t.elapsed().as_secs_f64() * 1e3;
     let mut scratch = Scratch::default();
     let mut out = Plane::default();
-    let mut rgb_out = Vec::new();
+    let mut rgb_out = <[Plane<f32>; 3]>::default();
     let mut ts = Vec::new();
     for _ in 0..3000 {
         let t = std::time::Instant::now();

@@ -12,7 +12,7 @@
 
 use crate::logpolar::{Fields, LogPolarConfig, LogPolarMap, Scratch};
 use crate::{FoveaError, Result};
-use ocellus_image::Plane;
+use ocellus_image::{Backend, Plane};
 
 /// Parameters of the vergence search.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -30,12 +30,23 @@ pub struct VergenceOptions {
     pub min_disparity: i64,
     /// Largest disparity searched, pixels.
     pub max_disparity: i64,
+    /// Which build of the log-polar kernels runs (`auto`: the fastest this CPU has).
+    #[serde(default)]
+    pub backend: Backend,
 }
 
 impl Default for VergenceOptions {
     /// 24 rings x 48 sectors between 2 and 24 px, disparities 0..=64 px.
     fn default() -> Self {
-        Self { rings: 24, sectors: 48, fovea_radius: 2.0, max_radius: 24.0, min_disparity: 0, max_disparity: 64 }
+        Self {
+            rings: 24,
+            sectors: 48,
+            fovea_radius: 2.0,
+            max_radius: 24.0,
+            min_disparity: 0,
+            max_disparity: 64,
+            backend: Backend::Auto,
+        }
     }
 }
 
@@ -102,6 +113,7 @@ fn foveal_config(opts: &VergenceOptions, centre: [f64; 2]) -> LogPolarConfig {
         max_level: 0,
         min_field_texels: 1.0,
         fields: Fields::Area,
+        backend: opts.backend,
     }
 }
 

@@ -38,12 +38,21 @@ pub struct BlockMatching {
     /// values (OpenCV's `PREFILTER_XSOBEL`, cap 31): robust to the exposure and lighting
     /// differences of real pairs. `None` matches raw grey values.
     pub prefilter_cap: Option<u8>,
+    /// Which build of the kernels runs (`Auto`: the fastest this CPU has).
+    pub backend: Backend,
 }
 
 impl Default for BlockMatching {
     /// 64 disparities, 9x9 blocks, uniqueness 0.15, left-right agreement within 1 px.
     fn default() -> Self {
-        Self { max_disparity: 64, block: 9, uniqueness: 0.15, lr_max_diff: 1.0, prefilter_cap: Some(31) }
+        Self {
+            max_disparity: 64,
+            block: 9,
+            uniqueness: 0.15,
+            lr_max_diff: 1.0,
+            prefilter_cap: Some(31),
+            backend: Backend::Auto,
+        }
     }
 }
 
@@ -119,7 +128,7 @@ fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, top: 
         )));
     }
     let mut out = Plane::new(w, h);
-    sad_kernel(Backend::Auto, left, right, p, &mut out);
+    sad_kernel(p.backend, left, right, p, &mut out);
     Ok(out)
 }
 

@@ -24,7 +24,7 @@
 use crate::{GeometryError, Result};
 use ocellus_image::filter::gaussian_blur;
 use ocellus_image::resample::sample_bilinear as sample;
-use ocellus_image::Plane;
+use ocellus_image::{Backend, Plane};
 use std::collections::HashMap;
 
 /// Detector settings. Board squares should be at least about 3 ring radii wide in the image.
@@ -38,11 +38,19 @@ pub struct ChessboardOptions {
     pub refine_half_window_px: usize,
     /// Least light-dark difference on the ring, as a fraction of the image's intensity range.
     pub min_contrast_frac: f32,
+    /// Which build of the smoothing kernels runs (`Auto`: the fastest this CPU has).
+    pub backend: Backend,
 }
 
 impl Default for ChessboardOptions {
     fn default() -> Self {
-        Self { smoothing_sigma_px: 1.5, ring_radius_px: 5.0, refine_half_window_px: 5, min_contrast_frac: 0.15 }
+        Self {
+            smoothing_sigma_px: 1.5,
+            ring_radius_px: 5.0,
+            refine_half_window_px: 5,
+            min_contrast_frac: 0.15,
+            backend: Backend::Auto,
+        }
     }
 }
 
@@ -154,8 +162,8 @@ pub fn saddles(img: &Plane<f32>, opts: &ChessboardOptions) -> Result<Vec<Saddle>
     if !img.all_finite() {
         return Err(GeometryError::Invalid("image has non-finite pixels".into()));
     }
-    let smooth = gaussian_blur(img, opts.smoothing_sigma_px)?;
-    let fine = gaussian_blur(img, 1.0)?;
+    let smooth = gaussian_blur(opts.backend, img, opts.smoothing_sigma_px)?;
+    let fine = gaussian_blur(opts.backend, img, 1.0)?;
     let (lo, hi) = smooth.min_max();
     let min_contrast = opts.min_contrast_frac * (hi - lo);
     let mut resp = Plane::<f32>::new(w, h);

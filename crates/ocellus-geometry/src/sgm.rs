@@ -57,6 +57,8 @@ pub struct Sgm {
     pub lr_max_diff: f32,
     /// 3x3 median of the valid disparities afterwards.
     pub median: bool,
+    /// Which build of the kernels runs (`Auto`: the fastest this CPU has).
+    pub backend: Backend,
 }
 
 impl Default for Sgm {
@@ -73,6 +75,7 @@ impl Default for Sgm {
             uniqueness: 0.05,
             lr_max_diff: 1.0,
             median: false,
+            backend: Backend::Auto,
         }
     }
 }
@@ -112,9 +115,9 @@ impl Sgm {
 
 /// Census transform: bit k set when neighbour k is darker than the centre (borders
 /// replicated).
-pub fn census(img: &Plane<u8>, width: usize, height: usize) -> Plane<u64> {
+pub fn census(backend: Backend, img: &Plane<u8>, width: usize, height: usize) -> Plane<u64> {
     let mut out = Plane::<u64>::new(img.width(), img.height());
-    census_kernel(Backend::Auto, img, width, height, &mut out);
+    census_kernel(backend, img, width, height, &mut out);
     out
 }
 
@@ -447,19 +450,19 @@ impl SgmMatcher {
         let d = p.max_disparity;
         let ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;
         let t = std::time::Instant::now();
-        census_kernel(Backend::Auto, left, p.census_width, p.census_height, &mut self.census_left);
-        census_kernel(Backend::Auto, right, p.census_width, p.census_height, &mut self.census_right);
+        census_kernel(p.backend, left, p.census_width, p.census_height, &mut self.census_left);
+        census_kernel(p.backend, right, p.census_width, p.census_height, &mut self.census_right);
         self.timings.census_ms = ms(t);
         let t = std::time::Instant::now();
-        costs_kernel(Backend::Auto, &self.census_left, &self.census_right, &mut self.cost, d);
+        costs_kernel(p.backend, &self.census_left, &self.census_right, &mut self.cost, d);
         self.timings.cost_ms = ms(t);
         let t = std::time::Instant::now();
         let diagonals = p.paths == SgmPaths::Eight;
-        pass_kernel(Backend::Auto, &self.cost, &mut self.sum, w, h, d, p.p1, p.p2, diagonals, true);
-        pass_kernel(Backend::Auto, &self.cost, &mut self.sum, w, h, d, p.p1, p.p2, diagonals, false);
+        pass_kernel(p.backend, &self.cost, &mut self.sum, w, h, d, p.p1, p.p2, diagonals, true);
+        pass_kernel(p.backend, &self.cost, &mut self.sum, w, h, d, p.p1, p.p2, diagonals, false);
         self.timings.aggregation_ms = ms(t);
         let t = std::time::Instant::now();
-        select_kernel(Backend::Auto, &self.sum, &mut self.raw, &p);
+        select_kernel(p.backend, &self.sum, &mut self.raw, &p);
         self.timings.selection_ms = ms(t);
         let t = std::time::Instant::now();
         self.timings.median_ms = 0.0;
@@ -569,7 +572,7 @@ mod tests {
     fn census_bits_match_a_direct_count() {
         let mut rng = SplitMix64::new(2);
         let img = Plane::from_fn(23, 17, |_, _| (rng.next_u64() & 255) as u8);
-        let c = census(&img, 5, 3);
+        let c = census(Backend::Scalar, &img, 5, 3);
         for (x, y) in [(0usize, 0usize), (11, 8), (22, 16), (3, 1)] {
             let mut want = 0u64;
             let mut bit = 0;
@@ -666,7 +669,7 @@ mod tests {
         let a = Plane::from_fn(64, 40, |_, _| (rng.next_u64() & 255) as u8);
         let b = Plane::from_fn(64, 40, |x, y| a.get((x + 3).min(63), y));
         let p = Sgm { max_disparity: 16, ..Default::default() };
-        let (cl, cr) = (census(&a, 9, 7), census(&b, 9, 7));
+        let (cl, cr) = (census(Backend::Scalar, &a, 9, 7), census(Backend::Scalar, &b, 9, 7));
         let mut sums = Vec::new();
         for backend in Backend::available() {
             let mut cost = vec![0u8; 64 * 40 * 16];

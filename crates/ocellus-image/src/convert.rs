@@ -40,14 +40,37 @@ impl RgbImage {
         }
     }
 
-    /// 8-bit luma, BT.601 weights (0.299, 0.587, 0.114), rounded and saturated.
+    /// Grey in [0, 1]: BT.601 luma (0.299 R + 0.587 G + 0.114 B), the workspace's one grey
+    /// conversion, unrounded.
+    pub fn to_grey(&self) -> Plane<f32> {
+        let (w, h) = self.size();
+        Plane::from_fn(w, h, |x, y| luma(self.get_f32(x, y)))
+    }
+
+    /// 8-bit luma: [`RgbImage::to_grey`] times 255, rounded and saturated.
     pub fn to_luma8(&self) -> Plane<u8> {
         let (w, h) = self.size();
-        Plane::from_fn(w, h, |x, y| {
-            let [r, g, b] = self.get_f32(x, y);
-            ((0.299 * r + 0.587 * g + 0.114 * b) * 255.0).round().clamp(0.0, 255.0) as u8
-        })
+        Plane::from_fn(w, h, |x, y| (luma(self.get_f32(x, y)) * 255.0).round().clamp(0.0, 255.0) as u8)
     }
+}
+
+/// BT.601 luma of an RGB triple, in the triple's units.
+pub fn luma([r, g, b]: [f32; 3]) -> f32 {
+    0.299 * r + 0.587 * g + 0.114 * b
+}
+
+/// The three channels of an 8-bit RGB image as float planes (grey levels 0..=255, the units
+/// of the bytes), for linear operators that keep units (resampling, remapping, log-polar).
+pub fn split_rgb8(p: &Plane<[u8; 3]>) -> [Plane<f32>; 3] {
+    std::array::from_fn(|c| p.map(|v| v[c] as f32))
+}
+
+/// 8-bit RGB from three float planes of grey levels 0..=255 (rounded, saturated): the
+/// inverse of [`split_rgb8`]. The planes must have the same size; the first one's is used.
+pub fn merge_rgb8(p: [&Plane<f32>; 3]) -> Plane<[u8; 3]> {
+    let (w, h) = p[0].size();
+    let at = |c: &Plane<f32>, x: usize, y: usize| if x < c.width() && y < c.height() { c.get(x, y) } else { 0.0 };
+    Plane::from_fn(w, h, |x, y| p.map(|c| at(c, x, y).round().clamp(0.0, 255.0) as u8))
 }
 
 /// Converts any decoded image to RGB, keeping 16-bit and float precision.

@@ -372,7 +372,7 @@ pub fn sep_filter(
 
 /// Separable Gaussian blur (clamped border, kernel cut at 3 sigma, normalized to sum 1);
 /// `sigma` in pixels; sigma < 0.3 returns a copy (the kernel would be a single tap).
-pub fn gaussian_blur(src: &Plane<f32>, sigma: f32) -> Result<Plane<f32>> {
+pub fn gaussian_blur(backend: Backend, src: &Plane<f32>, sigma: f32) -> Result<Plane<f32>> {
     if !(sigma.is_finite() && sigma >= 0.0) {
         return Err(ImageError::InvalidParameter(format!("blur sigma {sigma} must be finite and >= 0")));
     }
@@ -384,7 +384,7 @@ pub fn gaussian_blur(src: &Plane<f32>, sigma: f32) -> Result<Plane<f32>> {
     let s: f32 = k.iter().sum();
     k.iter_mut().for_each(|v| *v /= s);
     let mut out = Plane::default();
-    sep_filter(Backend::Auto, src, &mut out, &k, &k, Border::Clamp, &mut FilterScratch::default())?;
+    sep_filter(backend, src, &mut out, &k, &k, Border::Clamp, &mut FilterScratch::default())?;
     Ok(out)
 }
 

@@ -396,10 +396,10 @@ fn vertical_bytes<M: Madd>(
 
 dispatch_kernel!(fn pyr_down_rgb8_kernel => pyr_down_rgb8_generic(src: &Plane<[u8; 3]>, dst: [&mut Plane<f32>; 3], kernel: &PyramidKernel, s: &mut PyrScratch));
 
-/// Allocating convenience wrapper of [`pyr_down`] (auto-detected backend).
-pub fn pyr_down_alloc(src: &Plane<f32>, kernel: &PyramidKernel) -> Result<Plane<f32>> {
+/// Allocating convenience wrapper of [`pyr_down`].
+pub fn pyr_down_alloc(backend: Backend, src: &Plane<f32>, kernel: &PyramidKernel) -> Result<Plane<f32>> {
     let mut dst = Plane::default();
-    pyr_down(Backend::Auto, src, &mut dst, kernel, &mut PyrScratch::default())?;
+    pyr_down(backend, src, &mut dst, kernel, &mut PyrScratch::default())?;
     Ok(dst)
 }
 

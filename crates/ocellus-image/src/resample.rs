@@ -77,8 +77,15 @@ impl Resampler {
     }
 
     /// Resamples `src` into `dst` (resized to the destination size); `row` is scratch space
-    /// (one source row), kept by the caller so that steady state allocates nothing.
-    pub fn apply_with(&self, src: &Plane<f32>, dst: &mut Plane<f32>, row: &mut Vec<f32>) -> Result<()> {
+    /// (one source row), kept by the caller so that steady state allocates nothing;
+    /// `backend` chooses the kernel's build.
+    pub fn apply_with(
+        &self,
+        backend: Backend,
+        src: &Plane<f32>,
+        dst: &mut Plane<f32>,
+        row: &mut Vec<f32>,
+    ) -> Result<()> {
         if src.size() != self.src {
             return Err(ImageError::SizeMismatch {
                 what: "resampler input",
@@ -89,13 +96,13 @@ impl Resampler {
             });
         }
         dst.resize(self.dst.0, self.dst.1);
-        resample_kernel(Backend::Auto, &self.xs, &self.ys, src, dst, row);
+        resample_kernel(backend, &self.xs, &self.ys, src, dst, row);
         Ok(())
     }
 
     /// Like [`apply_with`](Self::apply_with) with a temporary row buffer (allocates).
-    pub fn apply(&self, src: &Plane<f32>, dst: &mut Plane<f32>) -> Result<()> {
-        self.apply_with(src, dst, &mut Vec::new())
+    pub fn apply(&self, backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>) -> Result<()> {
+        self.apply_with(backend, src, dst, &mut Vec::new())
     }
 }
 
@@ -143,10 +150,10 @@ pub fn sample_bilinear(img: &Plane<f32>, x: f32, y: f32) -> f32 {
     top + ay * (bot - top)
 }
 
-/// Allocating convenience: resample `src` to `w` x `h`.
-pub fn resize(src: &Plane<f32>, w: usize, h: usize, method: ResampleMethod) -> Result<Plane<f32>> {
+/// Allocating convenience: resample `src` to `w` x `h` with `backend`'s kernel.
+pub fn resize(backend: Backend, src: &Plane<f32>, w: usize, h: usize, method: ResampleMethod) -> Result<Plane<f32>> {
     let r = Resampler::new(method, src.size(), (w, h))?;
     let mut dst = Plane::default();
-    r.apply(src, &mut dst)?;
+    r.apply(backend, src, &mut dst)?;
     Ok(dst)
 }

@@ -8,16 +8,23 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Which build of the hot kernels to run.
+/// Which build of the hot kernels to run: the caller chooses one (in an engine's config or as
+/// a function's first argument) and it is passed down to every kernel the call reaches, so
+/// that `Scalar` runs no SIMD code anywhere. Conformance tests run every entry of
+/// [`Backend::available`] against `Scalar`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum Backend {
     /// The fastest one this CPU supports (decided once per call of [`Backend::resolve`]).
     #[default]
     Auto,
-    /// Portable code, no CPU feature assumed.
+    /// Portable code, no CPU feature assumed: the reference every other backend is tested
+    /// against.
     Scalar,
-    /// AVX2 + FMA (x86-64 only).
+    /// SSE4.1 + SSSE3 (x86-64): the 128-bit integer kernels (log-polar box pyramid, SAD block
+    /// search); the float kernels run their portable build.
+    Sse41,
+    /// AVX2 + FMA (x86-64), which implies SSE4.1: every kernel's widest build.
     Avx2,
 }
 
@@ -26,23 +33,30 @@ impl Backend {
     pub fn detect() -> Backend {
         if avx2_available() {
             Backend::Avx2
+        } else if sse41_available() {
+            Backend::Sse41
         } else {
             Backend::Scalar
         }
     }
 
-    /// Turns `Auto` into a concrete backend; an unavailable `Avx2` falls back to `Scalar`.
+    /// Turns `Auto` into a concrete backend; an unavailable one falls back to the best
+    /// available below it (`Avx2` to `Sse41` to `Scalar`).
     pub fn resolve(self) -> Backend {
         match self {
             Backend::Auto => Backend::detect(),
-            Backend::Avx2 if !avx2_available() => Backend::Scalar,
+            Backend::Avx2 if !avx2_available() => Backend::Sse41.resolve(),
+            Backend::Sse41 if !sse41_available() => Backend::Scalar,
             b => b,
         }
     }
 
-    /// Every concrete backend this CPU can run (for conformance tests).
+    /// Every concrete backend this CPU can run, `Scalar` first (for conformance tests).
     pub fn available() -> Vec<Backend> {
         let mut v = vec![Backend::Scalar];
+        if sse41_available() {
+            v.push(Backend::Sse41);
+        }
         if avx2_available() {
             v.push(Backend::Avx2);
         }
@@ -53,6 +67,7 @@ impl Backend {
     pub fn name(self) -> &'static str {
         match self.resolve() {
             Backend::Avx2 => "avx2+fma",
+            Backend::Sse41 => "sse4.1",
             _ => "scalar",
         }
     }
@@ -63,7 +78,20 @@ impl Backend {
 pub fn avx2_available() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")
+        is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") && sse41_available()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// True when the CPU has SSE4.1 and SSSE3.
+#[inline]
+pub fn sse41_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        is_x86_feature_detected!("sse4.1") && is_x86_feature_detected!("ssse3")
     }
     #[cfg(not(target_arch = "x86_64"))]
     {

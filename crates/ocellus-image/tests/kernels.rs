@@ -72,14 +72,14 @@ fn seed_border_weights_are_reproduced() {
     for y in 0..16 {
         src.set(0, y, 1.0);
     }
-    let out = ocellus_image::pyramid::pyr_down_alloc(&src, &PyramidKernel::itti()).unwrap();
+    let out = ocellus_image::pyramid::pyr_down_alloc(Backend::Scalar, &src, &PyramidKernel::itti()).unwrap();
     assert!((out.get(0, 3) - 10.0 / 26.0).abs() < 1e-6);
     // and an interior impulse at column 8: outputs 3, 4, 5 see taps 1, 10, 5 of 32 (offsets +2, 0, -2 ... )
     let mut src = Plane::<f32>::new(16, 16);
     for y in 0..16 {
         src.set(8, y, 1.0);
     }
-    let out = ocellus_image::pyramid::pyr_down_alloc(&src, &PyramidKernel::itti()).unwrap();
+    let out = ocellus_image::pyramid::pyr_down_alloc(Backend::Scalar, &src, &PyramidKernel::itti()).unwrap();
     let row: Vec<f32> = out.row(4).to_vec();
     assert!(
         (row[3] - 5.0 / 32.0).abs() < 1e-6 && (row[4] - 10.0 / 32.0).abs() < 1e-6 && (row[5] - 1.0 / 32.0).abs() < 1e-6,
@@ -90,7 +90,7 @@ fn seed_border_weights_are_reproduced() {
 #[test]
 fn stb_size3_rule() {
     let src = Plane::from_fn(5, 3, |x, y| (x + 10 * y) as f32);
-    let out = ocellus_image::pyramid::pyr_down_alloc(&src, &PyramidKernel::stb()).unwrap();
+    let out = ocellus_image::pyramid::pyr_down_alloc(Backend::Scalar, &src, &PyramidKernel::stb()).unwrap();
     assert_eq!(out.size(), (2, 1));
     // rows 0, 1, 2 weighted 1/4, 1/2, 1/4 -> row value 10 plus the horizontal part
     let horiz: Vec<f64> = {
@@ -227,12 +227,12 @@ fn nearest_resize_reproduces_octave_indices() {
     ];
     for (n_in, n_out, want) in cases {
         let src = Plane::from_fn(1, n_in, |_, y| (y + 1) as f32);
-        let out = resize(&src, 1, n_out, ResampleMethod::Nearest).unwrap();
+        let out = resize(Backend::Scalar, &src, 1, n_out, ResampleMethod::Nearest).unwrap();
         let got: Vec<usize> = (0..n_out).map(|y| out.get(0, y) as usize).collect();
         assert_eq!(got, want, "{n_in} -> {n_out}");
     }
     let src = Plane::from_fn(5, 1, |x, _| (x + 1) as f32);
-    let out = resize(&src, 40, 1, ResampleMethod::Nearest).unwrap();
+    let out = resize(Backend::Scalar, &src, 40, 1, ResampleMethod::Nearest).unwrap();
     let got: Vec<usize> = (0..40).map(|x| out.get(x, 0) as usize).collect();
     assert_eq!(got, (0..40).map(|k| k / 8 + 1).collect::<Vec<_>>());
 }
@@ -240,15 +240,15 @@ fn nearest_resize_reproduces_octave_indices() {
 #[test]
 fn bilinear_resize_properties() {
     let src = noise(17, 9, 5);
-    assert_eq!(resize(&src, 17, 9, ResampleMethod::Bilinear).unwrap(), src);
+    assert_eq!(resize(Backend::Scalar, &src, 17, 9, ResampleMethod::Bilinear).unwrap(), src);
     // A linear ramp stays a ramp away from the clamped borders.
     let ramp = Plane::from_fn(10, 4, |x, _| x as f32);
-    let up = resize(&ramp, 40, 4, ResampleMethod::Bilinear).unwrap();
+    let up = resize(Backend::Scalar, &ramp, 40, 4, ResampleMethod::Bilinear).unwrap();
     for x in 4..36 {
         let want = (x as f32 + 0.5) * 10.0 / 40.0 - 0.5;
         assert!((up.get(x, 2) - want).abs() < 1e-5);
     }
-    assert!(resize(&src, 0, 3, ResampleMethod::Bilinear).is_err());
+    assert!(resize(Backend::Scalar, &src, 0, 3, ResampleMethod::Bilinear).is_err());
 }
 
 #[test]

@@ -10,7 +10,7 @@ use ocellus_synth::ground::{GroundConfig, GroundScene, GroundTexture};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let textures = ["brick.png", "grass.png", "gravel.png"].map(ocellus_testdata::asset);
-    let textures = textures.map(|p| ocellus_io::read_image(p).map(|i| i.to_luma8().map(|v| v as f32)));
+    let textures = textures.map(|p| ocellus_io::read_image(p).map(|i| i.to_grey()));
     let [a, b, c] = textures;
     let cfg = GroundConfig { frames: 200, ..GroundConfig::easy(GroundTexture::Mosaic, 1) };
     let scene = GroundScene::new(cfg, [a?, b?, c?])?;

@@ -11,7 +11,7 @@ use ocellus_synth::ground::{GroundConfig, GroundScene, GroundTexture};
 
 fn main() {
     let textures: [Plane<f32>; 3] = ["brick.png", "grass.png", "gravel.png"]
-        .map(|n| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap().to_luma8().map(|v| v as f32));
+        .map(|n| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap().to_grey());
     println!("texture  variant  mode    drift % (3 seeds)           mean   heading deg (3 seeds)        mean");
     for texture in [GroundTexture::Brick, GroundTexture::Grass, GroundTexture::Gravel, GroundTexture::Mosaic] {
         for hard in [false, true] {

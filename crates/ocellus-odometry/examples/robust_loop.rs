@@ -7,7 +7,7 @@ use ocellus_synth::ground::{GroundConfig, GroundScene, GroundTexture};
 
 fn main() {
     let textures: [Plane<f32>; 3] = ["brick.png", "grass.png", "gravel.png"]
-        .map(|n| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap().to_luma8().map(|v| v as f32));
+        .map(|n| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap().to_grey());
     // The texture as the first argument (brick, grass, gravel; mosaic by default).
     let texture = match std::env::args().nth(1).as_deref() {
         Some("brick") => GroundTexture::Brick,

@@ -13,8 +13,7 @@
 //! group keeps a flow is reported as [`OdometryError::NoTexture`].
 
 use crate::{OdometryError, Result};
-use ocellus_image::simd::Madd;
-use ocellus_image::{dispatch_kernel, Backend, Plane};
+use ocellus_image::{Backend, Plane};
 
 /// Parameters of the flow measurement (the seed's defaults).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -30,12 +29,15 @@ pub struct SadFlowConfig {
     pub group: usize,
     /// Flows farther than this from their group's median (per axis) are outliers, pixels.
     pub outlier_px: f64,
+    /// Which build of the block search runs (`auto`: the fastest this CPU has).
+    #[serde(default)]
+    pub backend: Backend,
 }
 
 impl Default for SadFlowConfig {
     /// 400x400 region, 20x20 windows, 8x8 blocks, 3x3 groups, outliers beyond 1 px.
     fn default() -> Self {
-        Self { region: 400, window: 20, block: 8, group: 3, outlier_px: 1.0 }
+        Self { region: 400, window: 20, block: 8, group: 3, outlier_px: 1.0, backend: Backend::Auto }
     }
 }
 
@@ -283,31 +285,28 @@ unsafe fn search_8x8_avx2(
     }
 }
 
-#[inline(always)]
-// The dispatch macro instantiates kernels per multiply-add flavour; integer kernels ignore it.
-#[allow(clippy::extra_unused_type_parameters)]
-fn windows_generic<M: Madd>(
-    prev: &Plane<u8>,
-    cur: &Plane<u8>,
-    cfg: &SadFlowConfig,
-    n: usize,
-    out: &mut Vec<WindowFlow>,
-) {
+/// The block search of every window with `cfg.backend`'s build: the 8x8 searches have
+/// hand-written SSE4.1 and AVX2 kernels (`_mm_sad_epu8`, `_mm_minpos_epu16`: the compiler
+/// does not find these from the scalar loop); other block sizes run the scalar search.
+fn windows_kernel(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig, n: usize, out: &mut Vec<WindowFlow>) {
     let (w, h) = prev.size();
     let (x0, y0) = ((w - cfg.region) / 2, (h - cfg.region) / 2);
     let (b, m) = (cfg.block, (cfg.window - cfg.block) / 2);
     let span = 2 * m + 1;
+    let backend = cfg.backend.resolve();
     #[cfg(target_arch = "x86_64")]
-    let fast = b == 8 && span <= 16 && x0 + (n - 1) * cfg.window + 32 <= w && is_x86_feature_detected!("sse4.1");
+    let fast = b == 8 && span <= 16 && x0 + (n - 1) * cfg.window + 32 <= w && backend != Backend::Scalar;
     #[cfg(target_arch = "x86_64")]
-    let avx2 = fast && is_x86_feature_detected!("avx2");
+    let avx2 = fast && backend == Backend::Avx2;
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = backend;
     out.clear();
     for j in 0..n {
         for i in 0..n {
             let (wx, wy) = (x0 + i * cfg.window, y0 + j * cfg.window);
             let (bx, by) = (wx + m, wy + m);
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: SSE4.1 (and AVX2 for `avx2`) detected; `fast` checked that 32 bytes from wx fit every row, and
+            // SAFETY: resolve() gives Sse41 or Avx2 only where the CPU has SSE4.1 (and AVX2 for `avx2`); `fast` checked that 32 bytes from wx fit every row, and
             // the window (rows wy..wy + span + 7) lies inside the region.
             let at = if avx2 {
                 unsafe { search_8x8_avx2(prev, cur, bx, by, wx, wy, span) }
@@ -324,10 +323,6 @@ fn windows_generic<M: Madd>(
     }
 }
 
-dispatch_kernel!(fn windows_kernel => windows_generic(
-    prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig, n: usize, out: &mut Vec<WindowFlow>
-));
-
 /// Every window's flow between `prev` and `cur`, row by row (window rows of the region).
 pub fn window_flows(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig) -> Result<Vec<WindowFlow>> {
     if prev.size() != cur.size() {
@@ -339,7 +334,7 @@ pub fn window_flows(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig) -> R
     }
     let n = cfg.check(prev.width(), prev.height())?;
     let mut out = Vec::with_capacity(n * n);
-    windows_kernel(Backend::Auto, prev, cur, cfg, n, &mut out);
+    windows_kernel(prev, cur, cfg, n, &mut out);
     Ok(out)
 }
 

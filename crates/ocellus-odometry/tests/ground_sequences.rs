@@ -9,7 +9,7 @@ use ocellus_synth::ground::{GroundConfig, GroundScene, GroundTexture};
 
 fn textures() -> [Plane<f32>; 3] {
     ["brick.png", "grass.png", "gravel.png"]
-        .map(|n| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap().to_luma8().map(|v| v as f32))
+        .map(|n| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap().to_grey())
 }
 
 /// Runs the odometry over a scene: (final drift in % of the path, final heading error in

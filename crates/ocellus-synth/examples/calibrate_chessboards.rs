@@ -17,8 +17,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let lens = Distortion { k1: -0.22, k2: 0.06, k3: 0.0, p1: 0.0008, p2: -0.0005 };
     let camera = BoardCamera::new(truth, lens, 640, 480)?;
     let board = Board::new(9, 6, 25.0)?; // 25 mm squares
-    let photo = ocellus_io::read_image(ocellus_testdata::asset("coffee.png"))?.to_luma8().map(|v| v as f32 / 255.0);
-    let background = resize(&photo, 640, 480, ResampleMethod::Bilinear)?;
+    let photo = ocellus_io::read_image(ocellus_testdata::asset("coffee.png"))?.to_grey();
+    let background = resize(ocellus_image::Backend::Auto, &photo, 640, 480, ResampleMethod::Bilinear)?;
     let mut rng = SplitMix64::new(7);
     let mut views = Vec::new();
     for k in 0..10 {

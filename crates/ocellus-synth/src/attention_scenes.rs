@@ -16,6 +16,7 @@
 use crate::texture::sample;
 use crate::{Result, SynthError};
 use ocellus_image::convert::RgbImage;
+use ocellus_image::location::cell_centre;
 use ocellus_image::rng::SplitMix64;
 use ocellus_image::Plane;
 use serde::{Deserialize, Serialize};
@@ -156,10 +157,8 @@ pub struct SceneGenerator {
 fn scaled(img: &RgbImage, w: usize, h: usize) -> Plane<[f32; 3]> {
     let (iw, ih) = img.size();
     let src = Plane::from_fn(iw, ih, |x, y| img.get_f32(x, y));
-    let (sx, sy) = (iw as f32 / w as f32, ih as f32 / h as f32);
-    Plane::from_fn(w, h, |x, y| {
-        sample(&src, ((x as f32 + 0.5) * sx - 0.5) as f64, ((y as f32 + 0.5) * sy - 0.5) as f64, false, false)
-    })
+    // Pixel (x, y) of the output is the point with the same cell position in the source.
+    Plane::from_fn(w, h, |x, y| sample(&src, cell_centre(x, w, iw), cell_centre(y, h, ih), false, false))
 }
 
 impl SceneGenerator {

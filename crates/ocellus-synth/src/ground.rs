@@ -201,12 +201,15 @@ pub struct GroundScene {
 }
 
 impl GroundScene {
-    /// Builds the sequence from the three textures (brick, grass, gravel; grey, any range,
-    /// each `TILE` x `TILE`).
+    /// Builds the sequence from the three textures (brick, grass, gravel; grey in [0, 1] as
+    /// [`ocellus_image::convert::RgbImage::to_grey`] makes it, each `TILE` x `TILE`).
     pub fn new(cfg: GroundConfig, textures: [Plane<f32>; 3]) -> Result<Self> {
         cfg.check()?;
         if textures.iter().any(|t| t.size() != (TILE, TILE)) {
             return Err(SynthError::InvalidConfig(format!("ground textures must be {TILE}x{TILE}")));
+        }
+        if textures.iter().any(|t| t.rows().flatten().any(|v| !(0.0..=1.0).contains(v))) {
+            return Err(SynthError::InvalidConfig("ground textures must hold grey levels in [0, 1]".into()));
         }
         let mut rng = SplitMix64::new(cfg.seed ^ 0x6f64_6f6d);
         let (sf, sl, sy) = (Smooth::new(&mut rng), Smooth::new(&mut rng), Smooth::new(&mut rng));
@@ -320,7 +323,7 @@ impl GroundScene {
         1.0 + self.cfg.height_oscillation * (std::f64::consts::TAU * t / 37.0).sin()
     }
 
-    /// Renders frame `k` (grey, the textures' range, before noise) at the exact pose, no blur.
+    /// Renders frame `k` (grey in [0, 1], before gain and noise) at the exact pose, no blur.
     fn render_at(&self, pose: &Pose2, scale: f64, out: &mut Plane<f32>, weight: f32) {
         let (w, h) = (self.cfg.width, self.cfg.height);
         let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
@@ -371,7 +374,7 @@ impl GroundScene {
         let gain = 1.0 + self.cfg.gain_flicker * (2.0 * rng.unit() as f32 - 1.0);
         let sigma = self.cfg.noise_sigma;
         Ok(Plane::from_fn(w, h, |x, y| {
-            let v = acc.get(x, y) * gain + if sigma > 0.0 { sigma * rng.normal() as f32 } else { 0.0 };
+            let v = acc.get(x, y) * gain * 255.0 + if sigma > 0.0 { sigma * rng.normal() as f32 } else { 0.0 };
             v.round().clamp(0.0, 255.0) as u8
         }))
     }
@@ -446,7 +449,8 @@ mod tests {
         std::array::from_fn(|i| {
             Plane::from_fn(TILE, TILE, |x, y| {
                 let (x, y) = (x as f32, y as f32);
-                128.0 + 60.0 * ((x * 0.07 + i as f32).sin() * (y * 0.05).cos()) + 30.0 * ((x + 2.0 * y) * 0.031).sin()
+                (128.0 + 60.0 * ((x * 0.07 + i as f32).sin() * (y * 0.05).cos()) + 30.0 * ((x + 2.0 * y) * 0.031).sin())
+                    / 255.0
             })
         })
     }

@@ -13,9 +13,8 @@ use ocellus_image::Plane;
 use ocellus_synth::chessboard::{Board, BoardCamera};
 
 fn background(w: usize, h: usize) -> Plane<f32> {
-    let photo = ocellus_io::read_image(ocellus_testdata::asset("coffee.png")).unwrap().to_luma8();
-    let grey = photo.map(|v| v as f32 / 255.0);
-    resize(&grey, w, h, ResampleMethod::Bilinear).unwrap()
+    let grey = ocellus_io::read_image(ocellus_testdata::asset("coffee.png")).unwrap().to_grey();
+    resize(ocellus_image::Backend::Auto, &grey, w, h, ResampleMethod::Bilinear).unwrap()
 }
 
 #[test]

@@ -3,6 +3,7 @@
 use super::{model_map, progress, EvalArgs, Model};
 use crate::inputs;
 use anyhow::{bail, Context, Result};
+use ocellus_eval::protocol::Sample;
 use ocellus_image::Plane;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -14,15 +15,6 @@ pub struct Item {
     pub stimulus: PathBuf,
     pub density: Option<PathBuf>,
     pub points: Option<PathBuf>,
-}
-
-/// One image ready to score: the model's map (None for `centre`), the fixation data, and the
-/// size every metric works at (the density map's, else the binary fixation map's, else the stimulus's).
-pub struct Sample {
-    pub map: Option<Plane<f32>>,
-    pub density: Option<Plane<f64>>,
-    pub fixations: Option<Vec<(usize, usize)>>,
-    pub size: (usize, usize),
 }
 
 fn files_with_stem(dir: &Path, stem: &str) -> Vec<PathBuf> {
@@ -48,14 +40,9 @@ fn find_points(dir: &Path, stem: &str) -> Option<PathBuf> {
     csv.or_else(|| files.into_iter().find(|p| ocellus_io::is_image_path(p)))
 }
 
-/// An image as grey values in [0, 1] (mean of R, G, B).
+/// An image as grey values in [0, 1] (BT.601 luma, the workspace's grey).
 pub fn grey(path: &Path) -> Result<Plane<f32>> {
-    let img = crate::budget::read_image(path)?;
-    let (w, h) = img.size();
-    Ok(Plane::from_fn(w, h, |x, y| {
-        let c = img.get_f32(x, y);
-        (c[0] + c[1] + c[2]) / 3.0
-    }))
+    Ok(crate::budget::read_image(path)?.to_grey())
 }
 
 /// The stimuli of `--stimuli` with their density maps and points files.
@@ -126,6 +113,8 @@ fn load_sample(item: &Item, model: &Model, engine: &mut Option<ocellus_attention
             fixations = Some(f);
         }
     }
+    // The size every metric works at: the density map's, else the binary fixation map's,
+    // else the stimulus's.
     let Some(size) = size else { bail!("{}: no fixation data", item.name) };
     if fixations.as_ref().is_some_and(|f| f.is_empty()) {
         bail!("{}: no fixation inside the image", item.name);
@@ -167,21 +156,4 @@ pub fn load_maps(items: &[Item], model: &Model) -> Result<Vec<Option<Plane<f32>>
         .collect::<Result<Vec<_>>>()?;
     bar.finish_and_clear();
     Ok(maps)
-}
-
-/// The fixations of every image but `i`, rescaled to image `i`'s pixels (pixel centres map to
-/// pixel centres): the negatives of the shuffled AUC.
-pub fn other_fixations(samples: &[Sample], i: usize) -> Vec<(usize, usize)> {
-    let (w, h) = samples[i].size;
-    let mut out = Vec::new();
-    for (j, s) in samples.iter().enumerate() {
-        let (Some(f), true) = (&s.fixations, j != i) else { continue };
-        let (sx, sy) = (w as f64 / s.size.0 as f64, h as f64 / s.size.1 as f64);
-        out.extend(f.iter().map(|&(x, y)| {
-            let tx = ((x as f64 + 0.5) * sx - 0.5).round().clamp(0.0, (w - 1) as f64);
-            let ty = ((y as f64 + 0.5) * sy - 0.5).round().clamp(0.0, (h - 1) as f64);
-            (tx as usize, ty as usize)
-        }));
-    }
-    out
 }

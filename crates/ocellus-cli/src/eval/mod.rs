@@ -10,33 +10,17 @@ mod tune;
 use crate::config_file;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use data::{Item, Sample};
+use data::Item;
 use indicatif::{ProgressBar, ProgressStyle};
-use ocellus_attention::center_prior::{center_gaussian, CenterPrior};
-use ocellus_attention::config::{ChannelConfig, ChannelKind};
+use ocellus_attention::config::ChannelKind;
 use ocellus_attention::{SaliencyConfig, SaliencyEngine};
-use ocellus_eval::metrics;
-use ocellus_image::Plane;
-use rayon::prelude::*;
+use ocellus_eval::center_prior::CenterPrior;
+use ocellus_eval::protocol::{
+    mean_se, no_prior, score_all, Scores, DEFAULT_PRIOR, DEFAULT_PRIOR_SKIN_WEIGHT, DENSITY_NAMES, LOCATION_NAMES,
+};
+use ocellus_image::{Backend, Plane};
 use serde_json::json;
 use std::path::PathBuf;
-
-/// Blur and prior shipped as the `--center-prior` defaults: what two-fold cross-validated grid
-/// search (`ocellus eval --tune`) chose on the 100-image MIT1003 subset (Judd et al. 2009) the project was tuned on: both folds
-/// chose skin weight 3, prior weight 0.60 and sigma 0.12, and blur 0.06 and 0.04 (we ship
-/// their mean).
-pub const DEFAULT_PRIOR: CenterPrior =
-    CenterPrior { blur_sigma_frac_width: 0.05, weight: 0.6, center_sigma_frac: 0.12 };
-
-/// Skin-channel weight of the `--center-prior` mode (both folds of `--tune` chose it).
-pub const DEFAULT_PRIOR_SKIN_WEIGHT: f32 = 3.0;
-
-/// The centre prior used as the IG baseline and as the `centre` model: sigma 0.25 of the larger side.
-const BASELINE_SIGMA_FRAC: f32 = 0.25;
-
-/// Seeded splits of the AUC-Borji and shuffled AUC (benchmark: 100 splits, thresholds step 0.1).
-const AUC_SPLITS: usize = 100;
-const AUC_STEP: f64 = 0.1;
 
 /// Arguments of `ocellus eval`.
 #[derive(Args, Debug)]
@@ -124,16 +108,7 @@ fn skin_weight(a: &EvalArgs) -> f32 {
 
 /// `cfg` with its skin channel set to `weight` (added if missing, removed for 0).
 pub(crate) fn with_skin(cfg: &SaliencyConfig, weight: f32) -> Result<SaliencyConfig> {
-    if !weight.is_finite() || weight < 0.0 {
-        bail!("--skin-weight must be >= 0, got {weight}");
-    }
-    let mut c = cfg.clone();
-    c.channels.retain(|ch| ch.kind != ChannelKind::Skin);
-    if weight > 0.0 {
-        c.channels.push(ChannelConfig { kind: ChannelKind::Skin, weight });
-    }
-    c.validate()?;
-    Ok(c)
+    Ok(cfg.with_channel_weight(ChannelKind::Skin, weight)?)
 }
 
 /// The model's map for one image (map level, or any size for `maps:`); None for `centre`.
@@ -157,53 +132,6 @@ pub(crate) fn model_map(model: &Model, item: &Item, engine: &mut Option<Saliency
     }
 }
 
-/// The evaluated map at `w` x `h`: the model's map with blur and prior, or the centre prior.
-pub(crate) fn final_map(map: Option<&Plane<f32>>, w: usize, h: usize, prior: &CenterPrior) -> Result<Plane<f64>> {
-    let full = match map {
-        Some(m) => prior.apply(m, w, h)?,
-        None => center_gaussian(w, h, prior.center_sigma_frac * w.max(h) as f32),
-    };
-    Ok(full.map(|v| v as f64))
-}
-
-/// CC, SIM, KL of `map` (prior applied) against the density map.
-pub(crate) fn density_metrics(map: Option<&Plane<f32>>, density: &Plane<f64>, prior: &CenterPrior) -> Result<[f64; 3]> {
-    let s = final_map(map, density.width(), density.height(), prior)?;
-    Ok([metrics::cc(&s, density)?, metrics::sim(&s, density)?, metrics::kl(&s, density)?])
-}
-
-/// NSS, AUC-Judd, AUC-Borji, sAUC, IG of `saliency` at the fixations; `others` are the other
-/// images' fixations in this image's pixels (sAUC negatives). Seeded by the image's index.
-fn location_metrics(
-    saliency: &Plane<f64>,
-    fixations: &[(usize, usize)],
-    others: &[(usize, usize)],
-    index: usize,
-) -> Result<[f64; 5]> {
-    let (w, h) = saliency.size();
-    let seed = 0x5eed_0000 + index as u64;
-    let baseline = center_gaussian(w, h, BASELINE_SIGMA_FRAC * w.max(h) as f32).map(|v| v as f64);
-    Ok([
-        metrics::nss(saliency, fixations)?,
-        metrics::auc_judd(saliency, fixations, seed)?,
-        metrics::auc_borji(saliency, fixations, AUC_SPLITS, AUC_STEP, seed)?,
-        // One image alone has no other images' fixations: no shuffled AUC.
-        if others.is_empty() {
-            f64::NAN
-        } else {
-            metrics::auc_shuffled(saliency, fixations, others, AUC_SPLITS, AUC_STEP, seed)?
-        },
-        metrics::info_gain(saliency, &baseline, fixations)?,
-    ])
-}
-
-pub(crate) fn mean_se(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let var = if v.len() > 1 { v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0) } else { 0.0 };
-    (m, (var / n).sqrt())
-}
-
 pub(crate) fn progress(n: usize, what: &str) -> ProgressBar {
     let b = ProgressBar::new(n as u64);
     b.set_style(
@@ -215,11 +143,7 @@ pub(crate) fn progress(n: usize, what: &str) -> ProgressBar {
 
 /// The blur and prior asked for on the command line.
 fn prior_from_args(a: &EvalArgs) -> Result<CenterPrior> {
-    let base = if a.center_prior {
-        DEFAULT_PRIOR
-    } else {
-        CenterPrior { blur_sigma_frac_width: 0.0, weight: 0.0, center_sigma_frac: BASELINE_SIGMA_FRAC }
-    };
+    let base = if a.center_prior { DEFAULT_PRIOR } else { no_prior() };
     let prior = CenterPrior {
         blur_sigma_frac_width: a.blur.unwrap_or(base.blur_sigma_frac_width),
         weight: a.prior_weight.unwrap_or(base.weight),
@@ -227,39 +151,6 @@ fn prior_from_args(a: &EvalArgs) -> Result<CenterPrior> {
     };
     prior.validate()?;
     Ok(prior)
-}
-
-/// Per-image values: the density metrics and the location metrics, where the inputs exist.
-struct Scores {
-    density: Option<[f64; 3]>,
-    location: Option<[f64; 5]>,
-}
-
-const DENSITY_NAMES: [&str; 3] = ["CC", "SIM", "KL"];
-const LOCATION_NAMES: [&str; 5] = ["NSS", "AUC-Judd", "AUC-Borji", "sAUC", "IG"];
-
-fn score_all(samples: &[Sample], prior: &CenterPrior) -> Result<Vec<Scores>> {
-    let bar = progress(samples.len(), "metrics");
-    let scores = samples
-        .par_iter()
-        .enumerate()
-        .map(|(i, s)| -> Result<Scores> {
-            let (w, h) = s.size;
-            let map = final_map(s.map.as_ref(), w, h, prior)?;
-            let density = match &s.density {
-                Some(d) => Some([metrics::cc(&map, d)?, metrics::sim(&map, d)?, metrics::kl(&map, d)?]),
-                None => None,
-            };
-            let location = match &s.fixations {
-                Some(f) => Some(location_metrics(&map, f, &data::other_fixations(samples, i), i)?),
-                None => None,
-            };
-            bar.inc(1);
-            Ok(Scores { density, location })
-        })
-        .collect::<Result<Vec<_>>>()?;
-    bar.finish_and_clear();
-    Ok(scores)
 }
 
 fn print_table(scores: &[Scores]) -> Result<()> {
@@ -331,7 +222,9 @@ pub fn run(a: EvalArgs) -> Result<()> {
     }
     let samples = data::load_samples(&items, &model)?;
     outln!("{} images, model {}", items.len(), a.model);
-    let scores = score_all(&samples, &prior)?;
+    let bar = progress(samples.len(), "metrics");
+    let scores = score_all(Backend::Auto, &samples, &prior, &|| bar.inc(1))?;
+    bar.finish_and_clear();
     outln!(
         "blur {:.3} of width, centre prior weight {:.2}, sigma {:.2} of the larger side",
         prior.blur_sigma_frac_width,

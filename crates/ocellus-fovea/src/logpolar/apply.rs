@@ -114,8 +114,8 @@ impl LogPolarMap {
 
     /// Grey images with [`Fields::Pyramid`]: the pyramid as exact u16 box sums (a level-l
     /// texel holds the sum of 4^l pixels; up to level 4 that fits), then each level's cells
-    /// as one run of bilinear quads, 8 cells per step with AVX2 gathers where the CPU has
-    /// them. Returns false (nothing done) when the map does not allow it.
+    /// as one run of bilinear quads, 8 cells per step with AVX2 gathers for a resolved
+    /// `Avx2` backend. Returns false (nothing done) when the map does not allow it.
     pub(super) fn apply_grey_pyramid(&self, src: &[u8], scratch: &mut Scratch, out: &mut [f32]) -> bool {
         if self.level_ranges.is_none() || src.len() < self.width * self.height || out.len() < self.quad_base.len() {
             return false;
@@ -153,6 +153,7 @@ impl LogPolarMap {
         if pyr.len() < self.pyramid_len() {
             return;
         }
+        let backend = self.cfg.backend.resolve();
         for l in 1..=self.levels {
             let Some(rect) = self.level_rect(l) else { continue };
             let (pw, _) = level_size(w, h, l - 1);
@@ -161,10 +162,10 @@ impl LogPolarMap {
             let dst = &mut hi[..lw * lh];
             if l == 1 {
                 if let Some(src) = level0 {
-                    sum4(src, pw, dst, lw, rect);
+                    sum4(backend, src, pw, dst, lw, rect);
                 }
             } else {
-                sum4(&lo[self.level_base[l - 1]..], pw, dst, lw, rect);
+                sum4(backend, &lo[self.level_base[l - 1]..], pw, dst, lw, rect);
             }
         }
     }
@@ -172,6 +173,7 @@ impl LogPolarMap {
     /// Every cell's quad, level by level; sums at level l are scaled by 4^-l.
     fn grey_quads<const K: usize>(&self, level0: [&[u8]; K], pyr: [&[u16]; K], mut out: [&mut [f32]; K]) {
         let Some(ranges) = &self.level_ranges else { return };
+        let backend = self.cfg.backend.resolve();
         for (l, r) in ranges.iter().enumerate() {
             if r.is_empty() || out.iter().any(|o| o.len() < r.end) {
                 continue;
@@ -185,9 +187,9 @@ impl LogPolarMap {
                 std::array::from_fn(|_| it.next().unwrap_or(&mut []))
             };
             if l == 0 {
-                quads(level0, lw, b, fx, fy, 1.0, o);
+                quads(backend, level0, lw, b, fx, fy, 1.0, o);
             } else {
-                quads(pyr, lw, b, fx, fy, scale, o);
+                quads(backend, pyr, lw, b, fx, fy, scale, o);
             }
         }
         for o in out.iter_mut() {
@@ -199,15 +201,16 @@ impl LogPolarMap {
     /// the interleaved pixels, the full-resolution channels split out only where level-0
     /// fields read, then the grey levels and quads per channel. Returns false (nothing done)
     /// when the map does not allow it.
-    pub(super) fn apply_rgb_pyramid(&self, flat: &[u8], scratch: &mut Scratch, out: &mut [f32]) -> bool {
+    pub(super) fn apply_rgb_pyramid(&self, flat: &[u8], scratch: &mut Scratch, out: &mut [&mut [f32]; 3]) -> bool {
         let (w, h) = (self.width, self.height);
         let (n, cells) = (w * h, self.quad_base.len());
-        if self.level_ranges.is_none() || flat.len() < 3 * n || out.len() < 3 * cells {
+        if self.level_ranges.is_none() || flat.len() < 3 * n || out.iter().any(|o| o.len() < cells) {
             return false;
         }
         // Planes `n + 320` bytes apart: whole multiples of 4 KiB (640x480 is 75 x 4 KiB) make
         // the three stores per pixel alias.
         let pitch = n + 320;
+        let backend = self.cfg.backend.resolve();
         let mut planes = std::mem::take(&mut scratch.planes);
         planes.resize(3 * pitch, 0);
         let plen = self.pyramid_len();
@@ -222,6 +225,7 @@ impl LogPolarMap {
             for y in y0..y1 {
                 let span = y * w + x0..y * w + x1;
                 deinterleave(
+                    backend,
                     &flat[3 * span.start..3 * span.end],
                     &mut r[span.clone()],
                     &mut g[span.clone()],
@@ -238,17 +242,16 @@ impl LogPolarMap {
                 let a = &flat[3 * (2 * y * w + 2 * x0)..3 * (2 * y * w + 2 * x1)];
                 let b = &flat[3 * ((2 * y + 1) * w + 2 * x0)..3 * ((2 * y + 1) * w + 2 * x1)];
                 let span = base + y * lw + x0..base + y * lw + x1;
-                sum4_rgb_row(a, b, &mut pr[span.clone()], &mut pg[span.clone()], &mut pb[span]);
+                sum4_rgb_row(backend, a, b, &mut pr[span.clone()], &mut pg[span.clone()], &mut pb[span]);
             }
         }
         for p in pyr.chunks_exact_mut(plen.max(1)).take(3) {
             self.grey_levels(None, p);
         }
-        let (o0, o12) = out.split_at_mut(cells);
-        let (o1, o2) = o12.split_at_mut(cells);
+        let [o0, o1, o2] = out;
         let level0 = [&planes[..n], &planes[pitch..pitch + n], &planes[2 * pitch..2 * pitch + n]];
         let p = [&pyr[..plen], &pyr[plen..2 * plen], &pyr[2 * plen..3 * plen]];
-        self.grey_quads(level0, p, [o0, o1, &mut o2[..cells]]);
+        self.grey_quads(level0, p, [&mut o0[..cells], &mut o1[..cells], &mut o2[..cells]]);
         scratch.planes = planes;
         scratch.pyramid_rgb = pyr;
         true

@@ -2,6 +2,8 @@
 //! the exact sums (u16, byte fast paths) of 2^l x 2^l pixels, with AVX2/SSSE3 row kernels,
 //! and the split of interleaved RGB into channels.
 
+use ocellus_image::Backend;
+
 /// Pixel types the pyramid reads: the sum of two is kept exactly in `Acc`.
 pub(super) trait Texel: Copy + Into<f32> {
     /// Pairwise sum type.
@@ -141,16 +143,17 @@ unsafe fn deinterleave_ssse3(rgb: &[u8], r: &mut [u8], g: &mut [u8], b: &mut [u8
 }
 
 /// Level-1 sums of the three channels: `r[i]` is the sum of the red bytes of pixels 2i and
-/// 2i + 1 of rows `a` and `b` (interleaved RGB), and so on; SSSE3 where the CPU has it.
-pub(super) fn sum4_rgb_row(a: &[u8], b: &[u8], r: &mut [u16], g: &mut [u16], bl: &mut [u16]) {
+/// 2i + 1 of rows `a` and `b` (interleaved RGB), and so on; AVX2 or SSSE3 kernels for the
+/// resolved `backend` of those.
+pub(super) fn sum4_rgb_row(backend: Backend, a: &[u8], b: &[u8], r: &mut [u16], g: &mut [u16], bl: &mut [u16]) {
     let n = r.len().min(g.len()).min(bl.len()).min(a.len() / 6).min(b.len() / 6);
     let mut done = 0;
     #[cfg(target_arch = "x86_64")]
-    if is_x86_feature_detected!("avx2") {
-        // SAFETY: AVX2 detected; the kernel stays inside the slices.
+    if backend == Backend::Avx2 {
+        // SAFETY: a resolved Avx2 means the CPU has AVX2; the kernel stays inside the slices.
         done = unsafe { sum4_rgb_row_avx2(&a[..6 * n], &b[..6 * n], &mut r[..n], &mut g[..n], &mut bl[..n]) };
-    } else if is_x86_feature_detected!("ssse3") {
-        // SAFETY: SSSE3 detected; the kernel stays inside the slices.
+    } else if backend == Backend::Sse41 {
+        // SAFETY: a resolved Sse41 means the CPU has SSSE3; the kernel stays inside the slices.
         done = unsafe { sum4_rgb_row_ssse3(&a[..6 * n], &b[..6 * n], &mut r[..n], &mut g[..n], &mut bl[..n]) };
     }
     for i in done..n {
@@ -239,14 +242,15 @@ unsafe fn sum4_rgb_row_avx2(a: &[u8], b: &[u8], r: &mut [u16], g: &mut [u16], bl
     }
 }
 
-/// Splits interleaved RGB bytes into three channel rows (SSSE3 where the CPU has it).
-pub(super) fn deinterleave(rgb: &[u8], r: &mut [u8], g: &mut [u8], b: &mut [u8]) {
+/// Splits interleaved RGB bytes into three channel rows (SSSE3 for a resolved `Sse41` or
+/// `Avx2` backend).
+pub(super) fn deinterleave(backend: Backend, rgb: &[u8], r: &mut [u8], g: &mut [u8], b: &mut [u8]) {
     let n = r.len().min(g.len()).min(b.len()).min(rgb.len() / 3);
     let (rgb, r, g, b) = (&rgb[..3 * n], &mut r[..n], &mut g[..n], &mut b[..n]);
     let mut done = 0;
     #[cfg(target_arch = "x86_64")]
-    if is_x86_feature_detected!("ssse3") {
-        // SAFETY: SSSE3 detected; the kernel stays inside the slices.
+    if backend != Backend::Scalar {
+        // SAFETY: resolved Sse41 and Avx2 imply SSSE3; the kernel stays inside the slices.
         done = unsafe { deinterleave_ssse3(rgb, r, g, b) };
     }
     for i in done..n {
@@ -287,18 +291,18 @@ unsafe fn sum4_u16_row_avx2(a: &[u16], b: &[u16], d: &mut [u16]) -> usize {
 /// What the u16 box-sum pyramid is summed from: u8 pixels or u16 sums of 4^(l-1) pixels
 /// (l <= 4, so every column sum stays below 2^15 until the last pair).
 pub(super) trait SumTexel: Copy + Into<u16> {
-    /// A kernel for the leading texels of a row (it returns how many it did), when the CPU
-    /// has what it needs.
-    fn row_kernel() -> Option<RowKernel<Self>>;
+    /// A kernel for the leading texels of a row (it returns how many it did), for a resolved
+    /// `backend` that has one.
+    fn row_kernel(backend: Backend) -> Option<RowKernel<Self>>;
 }
 
 /// Sums of 2x2 elements of rows `a` and `b` into `d`; returns how many were done.
 type RowKernel<T> = unsafe fn(&[T], &[T], &mut [u16]) -> usize;
 
 impl SumTexel for u8 {
-    fn row_kernel() -> Option<RowKernel<u8>> {
+    fn row_kernel(backend: Backend) -> Option<RowKernel<u8>> {
         #[cfg(target_arch = "x86_64")]
-        if is_x86_feature_detected!("avx2") {
+        if backend == Backend::Avx2 {
             return Some(sum4_row_avx2 as RowKernel<u8>);
         }
         None
@@ -306,9 +310,9 @@ impl SumTexel for u8 {
 }
 
 impl SumTexel for u16 {
-    fn row_kernel() -> Option<RowKernel<u16>> {
+    fn row_kernel(backend: Backend) -> Option<RowKernel<u16>> {
         #[cfg(target_arch = "x86_64")]
-        if is_x86_feature_detected!("avx2") {
+        if backend == Backend::Avx2 {
             return Some(sum4_u16_row_avx2 as RowKernel<u16>);
         }
         None
@@ -316,16 +320,16 @@ impl SumTexel for u16 {
 }
 
 /// One level of the u16 box-sum pyramid: texels `rect` of `dst` (rows of `lw`) are the sums
-/// of 2x2 elements of `src` (rows of `sw`); 16 texels per step with AVX2 where the CPU has it.
-pub(super) fn sum4<T: SumTexel>(src: &[T], sw: usize, dst: &mut [u16], lw: usize, rect: [usize; 4]) {
+/// of 2x2 elements of `src` (rows of `sw`); 16 texels per step for a resolved `Avx2`.
+pub(super) fn sum4<T: SumTexel>(backend: Backend, src: &[T], sw: usize, dst: &mut [u16], lw: usize, rect: [usize; 4]) {
     let [x0, y0, x1, y1] = rect;
     let n = x1 - x0;
-    let kernel = T::row_kernel();
+    let kernel = T::row_kernel(backend);
     for y in y0..y1 {
         let a = &src[2 * y * sw + 2 * x0..][..2 * n];
         let b = &src[(2 * y + 1) * sw + 2 * x0..][..2 * n];
         let d = &mut dst[y * lw + x0..y * lw + x1];
-        // SAFETY: a kernel is only given when the CPU has its features; it stays inside the
+        // SAFETY: a kernel is only given for a resolved backend, whose features the CPU has; it stays inside the
         // three slices.
         let done = kernel.map_or(0, |k| unsafe { k(a, b, d) });
         for i in done..n {

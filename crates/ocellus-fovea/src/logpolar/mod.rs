@@ -38,7 +38,7 @@ mod quads;
 mod tests;
 
 use crate::{FoveaError, Result};
-use ocellus_image::Plane;
+use ocellus_image::{Backend, Plane};
 use std::f64::consts::TAU;
 
 /// Parameters of a log-polar map.
@@ -65,6 +65,9 @@ pub struct LogPolarConfig {
     pub min_field_texels: f64,
     /// The shape of the receptive fields.
     pub fields: Fields,
+    /// Which build of the byte fast paths' kernels runs (`auto`: the fastest this CPU has).
+    #[serde(default)]
+    pub backend: Backend,
 }
 
 /// The shape of the receptive fields.
@@ -97,6 +100,7 @@ impl LogPolarConfig {
             max_level: 4,
             min_field_texels: 1.0,
             fields: Fields::Pyramid,
+            backend: Backend::Auto,
         }
     }
 
@@ -568,31 +572,39 @@ impl LogPolarMap {
 
     /// The cortical image of an RGB image: three planes (r, g, b), grey levels 0..255.
     pub fn sample_rgb(&self, img: &Plane<[u8; 3]>) -> Result<[Plane<f32>; 3]> {
-        let mut out = vec![0.0f32; 3 * self.rows * self.cfg.sectors];
+        let mut out = <[Plane<f32>; 3]>::default();
         self.sample_rgb_into(img, &mut Scratch::default(), &mut out)?;
-        let n = self.rows * self.cfg.sectors;
-        let plane = |c: usize| {
-            Plane::from_vec(self.cfg.sectors, self.rows, out[c * n..(c + 1) * n].to_vec()).unwrap_or_default()
-        };
-        Ok([plane(0), plane(1), plane(2)])
+        Ok(out)
     }
 
-    /// [`Self::sample_rgb`] into reused buffers: `out` is resized to `3 rows sectors`: the
-    /// red cortical image, then the green, then the blue (each row-major, `sectors` wide).
-    pub fn sample_rgb_into(&self, img: &Plane<[u8; 3]>, scratch: &mut Scratch, out: &mut Vec<f32>) -> Result<()> {
+    /// [`Self::sample_rgb`] into reused planes (r, g, b), each resized to `sectors` x `rows`:
+    /// steady state allocates nothing.
+    pub fn sample_rgb_into(
+        &self,
+        img: &Plane<[u8; 3]>,
+        scratch: &mut Scratch,
+        out: &mut [Plane<f32>; 3],
+    ) -> Result<()> {
         self.check_size(img.width(), img.height())?;
         let cells = self.rows * self.cfg.sectors;
-        out.resize(3 * cells, 0.0);
+        for o in out.iter_mut() {
+            o.resize(self.cfg.sectors, self.rows);
+        }
         let src = contiguous(img);
         let flat: &[u8] = src.as_flattened();
-        if self.cfg.fields == Fields::Pyramid && self.apply_rgb_pyramid(flat, scratch, out) {
+        let [r, g, b] = out;
+        let mut o = [out_slice(r), out_slice(g), out_slice(b)];
+        if o.iter().any(|s| s.len() < cells) {
+            return Err(FoveaError::Invalid("cortical planes are not contiguous".into()));
+        }
+        if self.cfg.fields == Fields::Pyramid && self.apply_rgb_pyramid(flat, scratch, &mut o) {
             return Ok(());
         }
         let mut mixed = std::mem::take(&mut scratch.channels);
         mixed.resize(3 * cells, 0.0);
         self.apply::<u8, 3>(flat, 0, scratch, &mut mixed);
         for (c, v) in mixed.chunks_exact(3).enumerate() {
-            (out[c], out[cells + c], out[2 * cells + c]) = (v[0], v[1], v[2]);
+            (o[0][c], o[1][c], o[2][c]) = (v[0], v[1], v[2]);
         }
         scratch.channels = mixed;
         Ok(())

@@ -1,6 +1,8 @@
 //! Bilinear quads: each [`super::Fields::Pyramid`] cell is one bilinear read of its level,
 //! 8 cells per step with AVX2 gathers where the CPU has them.
 
+use ocellus_image::Backend;
+
 /// Sources of the grey fast path: u8 pixels (level 0) or u16 box sums.
 pub(super) trait Quad: Copy + Into<f32> {
     /// Whether 8 quads can be read with AVX2 gathers from a buffer of `len` elements with rows
@@ -24,6 +26,7 @@ impl Quad for u16 {
 /// (fx, fy), times `scale`, into `out`, for K sources with the same layout at once (the
 /// quads' positions are loaded once); `max_base` is the largest of `bases`.
 pub(super) fn quads<T: Quad, const K: usize>(
+    backend: Backend,
     src: [&[T]; K],
     lw: usize,
     (bases, max_base): (&[u32], usize),
@@ -37,9 +40,9 @@ pub(super) fn quads<T: Quad, const K: usize>(
     #[cfg(target_arch = "x86_64")]
     if n >= 8
         && src.iter().all(|s| s.len() < i32::MAX as usize && T::gather_safe(max_base, lw, s.len()))
-        && is_x86_feature_detected!("avx2")
+        && backend == Backend::Avx2
     {
-        // SAFETY: AVX2 detected; every gather reads inside its source (checked just above).
+        // SAFETY: a resolved Avx2 means the CPU has AVX2; every gather reads inside its source (checked just above).
         done = unsafe { quads_avx2(src, lw, &bases[..n], &fx[..n], &fy[..n], scale, &mut out) };
     }
     for (s, o) in src.iter().zip(out.iter_mut()) {

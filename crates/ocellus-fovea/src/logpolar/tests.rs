@@ -14,6 +14,7 @@ proptest! {
         let cfg = LogPolarConfig {
             rings, sectors, fovea_rings, fovea_radius: rho0, max_radius: rho_max, centre: [cx, cy], max_level,
             min_field_texels: 1.0, fields: if area { Fields::Area } else { Fields::Pyramid },
+            backend: ocellus_image::Backend::Auto,
         };
         if let Ok(map) = LogPolarMap::new(&cfg, w, h) {
             let mut rng = ocellus_image::rng::SplitMix64::new(seed);
@@ -107,6 +108,7 @@ fn a_shifted_map_equals_one_built_at_the_new_gaze_point() {
         max_level: 0,
         min_field_texels: 1.0,
         fields: Fields::Area,
+        backend: ocellus_image::Backend::Auto,
     };
     let map = LogPolarMap::new(&cfg, w, h).unwrap();
     let moved = map.shifted(-17, 9).unwrap();

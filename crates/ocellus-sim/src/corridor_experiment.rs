@@ -10,23 +10,19 @@
 //! the burst of step `event_step`. Nothing in the loop knows where the person or the
 //! landmarks should be looked at: the choice comes from the gains.
 
-use crate::assets;
-use anyhow::{Context, Result};
+use crate::{Result, SimError};
 use nalgebra::{Matrix2, Vector2};
-use ocellus_attention::chaos::{ChaosConfig, ChaosDegree};
-use ocellus_attention::config::{ChannelConfig, ChannelKind};
 use ocellus_attention::planning::{Decision, PlannerConfig, ViewPlanner};
-use ocellus_attention::surprise::{Surprise, SurpriseConfig};
-use ocellus_attention::{SaliencyConfig, SaliencyEngine};
+use ocellus_attention::stream::{StreamConfig, StreamEngine};
 use ocellus_estimation::bearing::{bearing, bearing_update, Landmark};
 use ocellus_image::convert::RgbImage;
 use ocellus_image::rng::SplitMix64;
 use ocellus_image::Plane;
 use ocellus_synth::corridor::{Corridor, CorridorConfig, CorridorTextures};
-use std::path::Path;
 
 /// Parameters of a run.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct RunConfig {
     /// Number of planning steps.
     pub steps: usize,
@@ -62,7 +58,7 @@ impl Default for RunConfig {
 }
 
 /// What happened at one step.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct StepRecord {
     /// Step index.
     pub step: usize,
@@ -90,16 +86,25 @@ pub struct StepRecord {
     pub surprise_max: f32,
 }
 
-fn asset(name: &str) -> Result<RgbImage> {
-    let bytes = assets::IMAGES
-        .iter()
-        .chain(assets::TEXTURES)
-        .find(|(n, _)| *n == name)
-        .map(|(_, b)| *b)
-        .context("missing asset")?;
-    Ok(ocellus_io::decode_image(bytes, Path::new(name))?)
+/// The photographs and textures the corridor is built from (any sizes; decoded by the
+/// caller, e.g. from the binary's built-in assets or from `assets/`).
+#[derive(Clone, Debug)]
+pub struct CorridorImages {
+    /// The person who appears (and a poster cut from it): the astronaut photograph.
+    pub astronaut: RgbImage,
+    /// Wall texture (brick).
+    pub brick: RgbImage,
+    /// Floor texture (gravel).
+    pub gravel: RgbImage,
+    /// Poster photographs: coffee, rocket, cat.
+    pub coffee: RgbImage,
+    /// See `coffee`.
+    pub rocket: RgbImage,
+    /// See `coffee`.
+    pub chelsea: RgbImage,
 }
 
+/// A `w` x `h` crop at (`x`, `y`) of `img`, clamped to the image.
 fn crop(img: &RgbImage, x: usize, y: usize, w: usize, h: usize) -> RgbImage {
     let (iw, ih) = img.size();
     let (w, h) = (w.min(iw - x.min(iw - 1)), h.min(ih - y.min(ih - 1)));
@@ -108,37 +113,51 @@ fn crop(img: &RgbImage, x: usize, y: usize, w: usize, h: usize) -> RgbImage {
 
 /// The corridor of the experiment: brick walls, gravel floor, posters cut from the coffee,
 /// rocket and cat photographs, and the astronaut as the person.
-pub fn corridor() -> Result<Corridor> {
-    let astronaut = asset("astronaut.png")?;
+pub fn corridor(images: &CorridorImages) -> Result<Corridor> {
     let tex = CorridorTextures {
-        wall: asset("brick.png")?,
-        floor: asset("gravel.png")?,
+        wall: images.brick.clone(),
+        floor: images.gravel.clone(),
         posters: vec![
-            crop(&asset("coffee.png")?, 150, 40, 300, 300),
-            crop(&asset("rocket.jpg")?, 200, 60, 240, 240),
-            crop(&asset("chelsea.png")?, 120, 20, 240, 240),
-            crop(&astronaut, 0, 0, 160, 160),
+            crop(&images.coffee, 150, 40, 300, 300),
+            crop(&images.rocket, 200, 60, 240, 240),
+            crop(&images.chelsea, 120, 20, 240, 240),
+            crop(&images.astronaut, 0, 0, 160, 160),
         ],
-        person: crop(&astronaut, 100, 0, 300, 512),
+        person: crop(&images.astronaut, 100, 0, 300, 512),
     };
     Ok(Corridor::new(CorridorConfig::default(), &tex)?)
+}
+
+impl RunConfig {
+    fn validate(&self) -> Result<()> {
+        use ocellus_image::check;
+        (|| {
+            check::within("steps", self.steps, 1, 100_000)?;
+            check::between("step_m", self.step_m, 0.0, 100.0)?;
+            check::within("odometry_sigma_m", self.odometry_sigma_m, 0.0, 10.0)?;
+            check::within("initial_sigma_m", self.initial_sigma_m, 1e-6, 10.0)
+        })()
+        .map_err(SimError::InvalidConfig)
+    }
 }
 
 /// Runs the experiment; returns one record per step. `on_step` sees each step's record with
 /// the last frame of its burst as it happens, so that frames are written, not kept: memory
 /// per step stays at the record's size (about a kilobyte) whatever the number of steps.
-pub fn run(
+///
+/// The saliency (ace2009 with flicker) → surprise → chaos chain is the library's
+/// [`StreamEngine`], reset at each burst (the camera has moved 0.5 m and turned). The callback's
+/// error type `E` is the caller's (e.g. `anyhow::Error`); the simulation's own errors convert
+/// into it.
+pub fn run<E: From<SimError>>(
     cfg: &RunConfig,
     world: &Corridor,
-    mut on_step: impl FnMut(&StepRecord, &RgbImage) -> Result<()>,
-) -> Result<Vec<StepRecord>> {
+    mut on_step: impl FnMut(&StepRecord, &RgbImage) -> std::result::Result<(), E>,
+) -> std::result::Result<Vec<StepRecord>, E> {
+    cfg.validate()?;
     let (w, h) = world.config().image_size;
-    let mut sal_cfg = SaliencyConfig::ace2009();
-    sal_cfg.channels.push(ChannelConfig { kind: ChannelKind::Flicker, weight: 1.0 });
-    let mut saliency = SaliencyEngine::new(sal_cfg, w, h)?;
-    let (mw, mh) = saliency.map_size();
-    let mut surprise = Surprise::new(SurpriseConfig::default(), mw, mh)?;
-    let mut chaos = ChaosDegree::new(ChaosConfig::default())?;
+    let mut stream = StreamEngine::new(StreamConfig::default(), w, h).map_err(SimError::from)?;
+    let (mw, _) = stream.saliency_engine().map_size();
     let landmarks: Vec<Landmark> = world.landmarks().into_iter().map(|(x, y)| Landmark { x, y }).collect();
     let planner_cfg = PlannerConfig {
         hfov_deg: world.config().hfov_deg,
@@ -146,7 +165,7 @@ pub fn run(
         ..PlannerConfig::default()
     };
     let sigma_bearing = planner_cfg.bearing_sigma_deg.to_radians();
-    let mut planner = ViewPlanner::new(planner_cfg, landmarks.clone())?;
+    let mut planner = ViewPlanner::new(planner_cfg, landmarks.clone()).map_err(SimError::from)?;
     let mut rng = SplitMix64::new(cfg.seed);
     let y0 = world.config().width_m / 2.0;
     let s0 = cfg.initial_sigma_m * cfg.initial_sigma_m;
@@ -164,18 +183,13 @@ pub fn run(
             cov += Matrix2::new(q, 0.0, 0.0, q);
         }
         // The burst: three frames from the true pose at the current pan.
-        saliency.reset_temporal();
-        surprise.reset();
-        chaos.reset();
+        stream.reset_temporal();
         let mut s = 0.0;
         let mut frame = None;
         for b in 0..3 {
             let show = cfg.event && (k > cfg.event_step || (k == cfg.event_step && b == 2));
             let img = world.render(truth.x, truth.y, pan, show, cfg.seed ^ ((k * 3 + b) as u64) << 8);
-            let sal = saliency.process(&img)?;
-            surprise.update(sal)?;
-            let grey = saliency.level(ocellus_attention::saliency::Source::Intensity, 2).context("level 2")?;
-            if let Some(c) = chaos.update(grey)? {
+            if let Some(c) = stream.process(&img, pan as f32, 0.0).map_err(SimError::from)?.chaos {
                 s = c;
             }
             frame = Some(img);
@@ -184,10 +198,11 @@ pub fn run(
         let seen = planner.visible_landmarks(&truth, 0.0, pan);
         let obs: Vec<(Landmark, f64)> =
             seen.iter().map(|l| (*l, bearing(&truth, l) + rng.normal() * sigma_bearing)).collect();
-        (mu, cov) = bearing_update(&mu, &cov, &obs, sigma_bearing)?;
+        (mu, cov) = bearing_update(&mu, &cov, &obs, sigma_bearing).map_err(SimError::from)?;
         // Plan for where the next observation happens: one step further, after its odometry.
         let (mu_next, cov_next) = (mu + Vector2::new(cfg.step_m, 0.0), cov + Matrix2::new(q, 0.0, 0.0, q));
-        let mut decision = planner.decide(&mu_next, &cov_next, 0.0, pan, surprise.map(), s)?;
+        let mut decision =
+            planner.decide(&mu_next, &cov_next, 0.0, pan, stream.surprise_map(), s).map_err(SimError::from)?;
         if cfg.fixed_forward {
             decision.pan_deg = 0.0;
         }
@@ -205,63 +220,13 @@ pub fn run(
             person_visible: in_burst && world.column_of(person_bearing_deg, pan).is_some(),
             person_bearing_deg,
             person_bearing_next_deg: bearing_from(truth.x + cfg.step_m),
-            surprise_max: surprise.map().min_max().1,
+            surprise_max: stream.surprise_map().min_max().1,
             decision: decision.clone(),
         };
-        on_step(&record, &frame.context("no frame")?)?;
+        let Some(frame) = frame else { return Err(SimError::InvalidConfig("a burst without frames".into()).into()) };
+        on_step(&record, &frame)?;
         records.push(record);
         pan = decision.pan_deg;
     }
     Ok(records)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn without_event_the_gaze_serves_localization() {
-        let world = corridor().unwrap();
-        let planned = run(&RunConfig::default(), &world, |_, _| Ok(())).unwrap();
-        let forward = run(&RunConfig { fixed_forward: true, ..Default::default() }, &world, |_, _| Ok(())).unwrap();
-        let angles: Vec<f64> = planned.iter().map(|r| r.decision.pan_deg).collect();
-        println!("no event, chosen angles: {angles:?}");
-        for r in &planned {
-            let chosen = r.decision.candidates.iter().find(|c| c.pan_deg == r.decision.pan_deg).unwrap();
-            assert!(chosen.landmarks_in_view >= 1, "step {}: {} sees no landmark", r.step, chosen.pan_deg);
-            assert_eq!(r.decision.v, 1.0, "step {}: chaos {} in a static corridor", r.step, r.chaos);
-        }
-        let (a, b) = (planned.last().unwrap().cov_trace, forward.last().unwrap().cov_trace);
-        println!("final covariance trace: planned {a:.5} m^2, fixed forward {b:.5} m^2");
-        assert!(a < b, "planned {a} vs forward {b}");
-    }
-
-    #[test]
-    fn the_sudden_person_turns_the_gaze() {
-        let world = corridor().unwrap();
-        let cfg = RunConfig { event: true, steps: 7, ..Default::default() };
-        let event = run(&cfg, &world, |_, _| Ok(())).unwrap();
-        let calm = run(&RunConfig { steps: 7, ..Default::default() }, &world, |_, _| Ok(())).unwrap();
-        let k = cfg.event_step;
-        let r = &event[k];
-        println!(
-            "event step {k}: pan {} -> {}, chaos {:.3}, person at {:.1} deg (next {:.1}); without event: -> {}",
-            r.pan_deg,
-            r.decision.pan_deg,
-            r.chaos,
-            r.person_bearing_deg,
-            r.person_bearing_next_deg,
-            calm[k].decision.pan_deg
-        );
-        assert!(r.person_visible, "the person must be in the burst's view");
-        assert!(r.chaos > 1.0, "chaos {}", r.chaos);
-        assert_eq!(r.decision.v, 0.0);
-        // The chosen pan is used at the next position: the person within 10 degrees of its centre.
-        assert!((r.decision.pan_deg - r.person_bearing_next_deg).abs() <= 10.0);
-        // Without the event the top-down choice stands at that step.
-        let c = &calm[k].decision;
-        let best_td = c.candidates.iter().fold(f64::MIN, |m, x| m.max(x.top_down_bits));
-        let chosen = c.candidates.iter().find(|x| x.pan_deg == c.pan_deg).unwrap();
-        assert_eq!(chosen.top_down_bits, best_td);
-    }
 }

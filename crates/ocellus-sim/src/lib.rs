@@ -1,0 +1,52 @@
+//! Closed-loop experiments: simulations in which what the robot sees depends on where it
+//! chose to look. Each runs the library's engines (saliency, surprise, chaos, planning,
+//! estimation) on frames rendered from real imagery by `ocellus-synth`, so that the CLI, the
+//! tests and the examples all run the same loop.
+//!
+//! - [`corridor_experiment`]: the seed's corridor (SPEC 2.6): information-based view
+//!   planning switching from landmarks to a suddenly appearing person.
+//!
+//! ```
+//! use ocellus_sim::corridor_experiment::{corridor, run, CorridorImages, RunConfig};
+//! use ocellus_sim::SimError;
+//! let read = |n: &str| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap();
+//! let images = CorridorImages {
+//!     astronaut: read("astronaut.png"),
+//!     brick: read("brick.png"),
+//!     gravel: read("gravel.png"),
+//!     coffee: read("coffee.png"),
+//!     rocket: read("rocket.jpg"),
+//!     chelsea: read("chelsea.png"),
+//! };
+//! let world = corridor(&images)?;
+//! let cfg = RunConfig { steps: 2, ..Default::default() };
+//! let records = run(&cfg, &world, |_, _| Ok::<(), SimError>(()))?;
+//! // Without an event the planner looks where landmarks are.
+//! assert!(records.iter().all(|r| r.decision.v == 1.0));
+//! # Ok::<(), SimError>(())
+//! ```
+
+pub mod corridor_experiment;
+
+/// Errors of the simulations.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// An engine of the attention crate failed (saliency, surprise, chaos, planning).
+    #[error(transparent)]
+    Attention(#[from] ocellus_attention::AttentionError),
+    /// The position belief's update failed.
+    #[error(transparent)]
+    Estimation(#[from] ocellus_estimation::EstimationError),
+    /// The scene generator failed.
+    #[error(transparent)]
+    Synth(#[from] ocellus_synth::SynthError),
+    /// A parameter is out of range.
+    #[error("invalid simulation parameter: {0}")]
+    InvalidConfig(String),
+    /// The callback given to a run reported an error; the run stopped there.
+    #[error("stopped by the step callback: {0}")]
+    Stopped(String),
+}
+
+/// Result of the simulations.
+pub type Result<T> = std::result::Result<T, SimError>;
