@@ -224,14 +224,9 @@ impl Attention {
             return Err(AttentionError::InvalidInput("attention needs a non-empty, finite saliency map".into()));
         }
         if let Some(s) = surprise {
-            if s.size() != saliency.size() || !s.all_finite() {
-                return Err(AttentionError::InvalidInput(format!(
-                    "surprise map {}x{} must be finite and the saliency map's size {}x{}",
-                    s.width(),
-                    s.height(),
-                    saliency.width(),
-                    saliency.height()
-                )));
+            ocellus_image::check::same_size("surprise map (against the saliency map)", s.size(), saliency.size())?;
+            if !s.all_finite() {
+                return Err(AttentionError::InvalidInput("the surprise map must be finite".into()));
             }
         }
         if !(pan_deg.is_finite() && tilt_deg.is_finite()) {

@@ -42,9 +42,13 @@ use thiserror::Error;
 /// Errors of the attention crate.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum AttentionError {
-    /// An image operation failed.
+    /// An image operation failed (the cause, for matching; e.g. `ImageError::SizeMismatch`
+    /// for a frame or map of the wrong size).
     #[error(transparent)]
     Image(#[from] ocellus_image::ImageError),
+    /// A belief update or information measure of the planner failed (the cause).
+    #[error(transparent)]
+    Estimation(#[from] ocellus_estimation::EstimationError),
     /// A configuration value is out of range.
     #[error("invalid configuration: {0}")]
     InvalidConfig(String),
@@ -59,18 +63,6 @@ pub enum AttentionError {
         levels: usize,
         /// Minimum side length.
         min_side: usize,
-    },
-    /// The frame's size differs from the engine's.
-    #[error("frame is {width}x{height} but the engine was built for {want_w}x{want_h}")]
-    FrameSize {
-        /// Frame width.
-        width: usize,
-        /// Frame height.
-        height: usize,
-        /// Engine width.
-        want_w: usize,
-        /// Engine height.
-        want_h: usize,
     },
     /// Other unusable input (maps, priors).
     #[error("invalid input: {0}")]

@@ -232,9 +232,8 @@ impl ViewPlanner {
         pan_deg: f64,
     ) -> Result<(f64, usize)> {
         let seen = self.visible_landmarks(mu, heading_deg, pan_deg);
-        let post = bearing_update_covariance(mu, cov, &seen, self.cfg.bearing_sigma_deg.to_radians())
-            .map_err(|e| AttentionError::InvalidInput(e.to_string()))?;
-        let kl = kl_bits(mu, cov, mu, &post).map_err(|e| AttentionError::InvalidInput(e.to_string()))?;
+        let post = bearing_update_covariance(mu, cov, &seen, self.cfg.bearing_sigma_deg.to_radians())?;
+        let kl = kl_bits(mu, cov, mu, &post)?;
         Ok((kl, seen.len()))
     }
 

@@ -340,9 +340,7 @@ impl SaliencyEngine {
     /// order), each of any size (resampled to pyramid level `min(center_levels)`).
     pub fn process_with_maps(&mut self, frame: &RgbImage, external: &[&Plane<f32>]) -> Result<&Plane<f32>> {
         let (w, h) = frame.size();
-        if (w, h) != (self.width, self.height) {
-            return Err(AttentionError::FrameSize { width: w, height: h, want_w: self.width, want_h: self.height });
-        }
+        ocellus_image::check::same_size("frame (against the engine's)", (w, h), (self.width, self.height))?;
         if external.len() != self.n_external {
             return Err(AttentionError::InvalidInput(format!(
                 "{} external maps given, the configuration has {} external channels",

@@ -134,15 +134,7 @@ impl Surprise {
     /// Updates the beliefs with `saliency` (same size as the engine, finite, >= 0) and returns
     /// the surprise map in bits.
     pub fn update(&mut self, saliency: &Plane<f32>) -> Result<&Plane<f32>> {
-        if saliency.size() != (self.width, self.height) {
-            return Err(AttentionError::InvalidInput(format!(
-                "surprise engine is {}x{}, map is {}x{}",
-                self.width,
-                self.height,
-                saliency.width(),
-                saliency.height()
-            )));
-        }
+        ocellus_image::check::same_size("saliency map given to surprise", saliency.size(), (self.width, self.height))?;
         if !saliency.all_finite() || saliency.min_max().0 < 0.0 {
             return Err(AttentionError::InvalidInput("saliency for surprise must be finite and >= 0".into()));
         }

@@ -8,7 +8,7 @@ use ocellus_attention::{AttentionError, SaliencyEngine};
 use ocellus_image::convert::RgbImage;
 use ocellus_image::filter::{correlate_2d_direct, Border};
 use ocellus_image::pyramid::pyr_down_alloc;
-use ocellus_image::{Backend, Plane};
+use ocellus_image::{Backend, ImageError, Plane};
 use ocellus_testdata::data_file;
 use proptest::prelude::*;
 
@@ -100,7 +100,7 @@ fn size_limits_give_clear_errors() {
     assert!(e.process(&img).unwrap().all_finite());
     let mut e = SaliencyEngine::new(SaliencyConfig::ace2009(), 256, 256).unwrap();
     let wrong = RgbImage::U8(Plane::new(300, 256));
-    assert!(matches!(e.process(&wrong), Err(AttentionError::FrameSize { .. })));
+    assert!(matches!(e.process(&wrong), Err(AttentionError::Image(ImageError::SizeMismatch { .. }))));
 }
 
 #[test]

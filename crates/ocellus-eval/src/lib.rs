@@ -28,20 +28,6 @@ pub enum EvalError {
     /// An image operation failed (the cause, for matching).
     #[error(transparent)]
     Image(#[from] ocellus_image::ImageError),
-    /// Two maps that must have the same size do not.
-    #[error("size mismatch: {what} is {got_w}x{got_h}, expected {want_w}x{want_h}")]
-    SizeMismatch {
-        /// Which map.
-        what: &'static str,
-        /// Its width.
-        got_w: usize,
-        /// Its height.
-        got_h: usize,
-        /// Expected width.
-        want_w: usize,
-        /// Expected height.
-        want_h: usize,
-    },
     /// The metric is undefined for this input (empty map, no fixations, non-finite values...).
     #[error("{metric} is undefined here: {why}")]
     Undefined {

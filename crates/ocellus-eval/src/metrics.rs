@@ -17,16 +17,7 @@ fn values(p: &Plane<f64>) -> Vec<f64> {
 }
 
 fn same_size(a: &Plane<f64>, b: &Plane<f64>, what: &'static str) -> Result<()> {
-    if a.size() != b.size() {
-        return Err(EvalError::SizeMismatch {
-            what,
-            got_w: b.width(),
-            got_h: b.height(),
-            want_w: a.width(),
-            want_h: a.height(),
-        });
-    }
-    Ok(())
+    Ok(ocellus_image::check::same_size(what, b.size(), a.size())?)
 }
 
 fn check(metric: &'static str, v: &[f64]) -> Result<()> {

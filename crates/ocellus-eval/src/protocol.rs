@@ -177,15 +177,7 @@ pub fn mean_se(v: &[f64]) -> (f64, f64) {
 pub fn check_sample(s: &Sample) -> Result<()> {
     let (w, h) = s.size;
     if let Some(d) = &s.density {
-        if d.size() != s.size {
-            return Err(EvalError::SizeMismatch {
-                what: "density map",
-                got_w: d.width(),
-                got_h: d.height(),
-                want_w: w,
-                want_h: h,
-            });
-        }
+        ocellus_image::check::same_size("density map", d.size(), s.size)?;
     }
     if let Some(f) = &s.fixations {
         if f.iter().any(|&(x, y)| x >= w || y >= h) {

@@ -44,18 +44,6 @@ pub enum FoveaError {
     /// A parameter is out of range.
     #[error("invalid log-polar parameter: {0}")]
     Invalid(String),
-    /// An image of the wrong size for the map or the other image.
-    #[error("image is {got_w}x{got_h}, expected {want_w}x{want_h}")]
-    Size {
-        /// Width given.
-        got_w: usize,
-        /// Height given.
-        got_h: usize,
-        /// Width expected.
-        want_w: usize,
-        /// Height expected.
-        want_h: usize,
-    },
     /// The images do not determine an answer (flat, or no overlap).
     #[error("no estimate: {0}")]
     NoEstimate(String),

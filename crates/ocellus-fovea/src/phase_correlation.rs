@@ -63,9 +63,7 @@ pub fn hann(img: &Plane<f32>, along_x: bool, along_y: bool) -> Plane<f32> {
 /// The shift of `b` relative to `a` (see the module doc). Both arrays must have the same
 /// size; they are used as given (window them first with [`hann`] where an axis is not cyclic).
 pub fn phase_correlate(a: &Plane<f32>, b: &Plane<f32>) -> Result<Shift> {
-    if a.size() != b.size() {
-        return Err(FoveaError::Size { got_w: b.width(), got_h: b.height(), want_w: a.width(), want_h: a.height() });
-    }
+    ocellus_image::check::same_size("second image (against the first)", b.size(), a.size())?;
     let (w, h) = a.size();
     if w < 2 || h < 1 {
         return Err(FoveaError::Invalid(format!("{w}x{h} is too small to correlate")));

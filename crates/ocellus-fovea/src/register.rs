@@ -82,9 +82,7 @@ pub struct RotationScale {
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
 pub fn register(a: &Plane<f32>, b: &Plane<f32>, opts: &RegisterOptions) -> Result<RotationScale> {
-    if a.size() != b.size() {
-        return Err(FoveaError::Size { got_w: b.width(), got_h: b.height(), want_w: a.width(), want_h: a.height() });
-    }
+    ocellus_image::check::same_size("second image (against the first)", b.size(), a.size())?;
     if a.width() < 16 || a.height() < 16 {
         return Err(FoveaError::Invalid(format!("{}x{} is too small to register", a.width(), a.height())));
     }

@@ -81,14 +81,7 @@ fn ncc(a: &Plane<f32>, b: &Plane<f32>) -> f64 {
 
 /// The disparity at `gaze` (x, y in the left image, pixel centres at integers).
 pub fn vergence(left: &Plane<u8>, right: &Plane<u8>, gaze: [f64; 2], opts: &VergenceOptions) -> Result<Vergence> {
-    if left.size() != right.size() {
-        return Err(FoveaError::Size {
-            got_w: right.width(),
-            got_h: right.height(),
-            want_w: left.width(),
-            want_h: left.height(),
-        });
-    }
+    ocellus_image::check::same_size("right image (against the left)", right.size(), left.size())?;
     if opts.min_disparity > opts.max_disparity || opts.max_disparity - opts.min_disparity > 100_000 {
         return Err(FoveaError::Invalid(format!("disparity range {}..={}", opts.min_disparity, opts.max_disparity)));
     }

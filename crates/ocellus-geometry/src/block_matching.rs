@@ -102,15 +102,7 @@ pub fn block_match(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
 
 /// `top`: the largest value the images can hold (for the 16-bit cost bound).
 fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, top: usize) -> Result<Plane<f32>> {
-    if left.size() != right.size() {
-        return Err(GeometryError::Invalid(format!(
-            "left image is {}x{}, right image {}x{}",
-            left.width(),
-            left.height(),
-            right.width(),
-            right.height()
-        )));
-    }
+    ocellus_image::check::same_size("right image (against the left)", right.size(), left.size())?;
     if p.block % 2 == 0 || p.block < 3 {
         return Err(GeometryError::Invalid(format!("block size {} must be odd and at least 3", p.block)));
     }
@@ -231,9 +223,7 @@ dispatch_kernel!(fn sad_kernel => sad_generic(left: &Plane<u8>, right: &Plane<u8
 /// `threshold` pixels, invalid estimates counted as bad (Middlebury "bad-2.0" for 2), and the
 /// density of valid estimates over those pixels.
 pub fn bad_pixels(estimate: &Plane<f32>, truth: &Plane<f32>, threshold: f32) -> Result<(f64, f64)> {
-    if estimate.size() != truth.size() {
-        return Err(GeometryError::Invalid("estimate and ground truth differ in size".into()));
-    }
+    ocellus_image::check::same_size("disparity estimate (against the ground truth)", estimate.size(), truth.size())?;
     let (mut known, mut bad, mut valid) = (0usize, 0usize, 0usize);
     for y in 0..truth.height() {
         for (&e, &t) in estimate.row(y).iter().zip(truth.row(y)) {

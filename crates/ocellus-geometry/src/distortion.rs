@@ -108,9 +108,7 @@ pub fn remap_bilinear(
     map_y: &ocellus_image::Plane<f32>,
     fill: f32,
 ) -> Result<ocellus_image::Plane<f32>> {
-    if map_x.size() != map_y.size() {
-        return Err(GeometryError::Invalid("remap tables differ in size".into()));
-    }
+    ocellus_image::check::same_size("remap table y (against x)", map_y.size(), map_x.size())?;
     let (w, h) = (src.width() as f32, src.height() as f32);
     Ok(ocellus_image::Plane::from_fn(map_x.width(), map_x.height(), |x, y| {
         let (u, v) = (map_x.get(x, y), map_y.get(x, y));

@@ -82,15 +82,7 @@ impl Default for Sgm {
 
 impl Sgm {
     fn check(&self, left: &Plane<u8>, right: &Plane<u8>) -> Result<()> {
-        if left.size() != right.size() {
-            return Err(GeometryError::Invalid(format!(
-                "stereo images differ in size: {}x{} and {}x{}",
-                left.width(),
-                left.height(),
-                right.width(),
-                right.height()
-            )));
-        }
+        ocellus_image::check::same_size("right image (against the left)", right.size(), left.size())?;
         ocellus_image::check::within("max_disparity", self.max_disparity, 1, 256).map_err(GeometryError::Invalid)?;
         ocellus_image::check::within("uniqueness", self.uniqueness, 0.0, 0.99).map_err(GeometryError::Invalid)?;
         let (cw, ch) = (self.census_width, self.census_height);
@@ -437,15 +429,7 @@ impl SgmMatcher {
     pub fn compute(&mut self, left: &Plane<u8>, right: &Plane<u8>) -> Result<&Plane<f32>> {
         let p = self.params;
         p.check(left, right)?;
-        if left.size() != self.size {
-            return Err(GeometryError::Invalid(format!(
-                "images are {}x{}, the matcher was made for {}x{}",
-                left.width(),
-                left.height(),
-                self.size.0,
-                self.size.1
-            )));
-        }
+        ocellus_image::check::same_size("images (against the matcher's)", left.size(), self.size)?;
         let (w, h) = self.size;
         let d = p.max_disparity;
         let ms = |t: std::time::Instant| t.elapsed().as_secs_f64() * 1e3;

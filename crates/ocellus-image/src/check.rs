@@ -1,9 +1,21 @@
 //! Range checks of named parameters, the one wording every crate's configuration errors use:
 //! the parameter's name, its value and the range it must lie in ("update_factor = 1.5 is
-//! outside (0, 1)"). Each returns the message, which the caller wraps in its own error type.
+//! outside (0, 1)"). Each returns the message, which the caller wraps in its own error type;
+//! [`same_size`] returns the typed size error.
 //! NaN fails every check.
 
+use crate::ImageError;
 use std::fmt::Display;
+
+/// `got` (width, height) equals `want`, else [`ImageError::SizeMismatch`] naming `what`: the
+/// one "wrong size" error of the workspace (other crates wrap it with `#[from]`, so a caller
+/// matches `Image(ImageError::SizeMismatch { .. })` whichever crate reported it).
+pub fn same_size(what: &'static str, got: (usize, usize), want: (usize, usize)) -> Result<(), ImageError> {
+    if got == want {
+        return Ok(());
+    }
+    Err(ImageError::SizeMismatch { what, got_w: got.0, got_h: got.1, want_w: want.0, want_h: want.1 })
+}
 
 /// `v` in `[lo, hi]`.
 pub fn within<T: PartialOrd + Display + Copy>(name: &str, v: T, lo: T, hi: T) -> Result<(), String> {

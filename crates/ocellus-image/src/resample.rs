@@ -86,15 +86,7 @@ impl Resampler {
         dst: &mut Plane<f32>,
         row: &mut Vec<f32>,
     ) -> Result<()> {
-        if src.size() != self.src {
-            return Err(ImageError::SizeMismatch {
-                what: "resampler input",
-                got_w: src.width(),
-                got_h: src.height(),
-                want_w: self.src.0,
-                want_h: self.src.1,
-            });
-        }
+        crate::check::same_size("resampler input", src.size(), self.src)?;
         dst.resize(self.dst.0, self.dst.1);
         resample_kernel(backend, &self.xs, &self.ys, src, dst, row);
         Ok(())

@@ -40,9 +40,10 @@ pub enum OdometryError {
     /// A parameter is out of range.
     #[error("invalid odometry parameter: {0}")]
     Invalid(String),
-    /// Frames of different sizes, or too small for the configured windows.
+    /// Frames too small for the configured windows (frames of different sizes are
+    /// `Image(ImageError::SizeMismatch)`).
     #[error("frame is {got_w}x{got_h}: {why}")]
-    FrameSize {
+    TooSmall {
         /// Width.
         got_w: usize,
         /// Height.

@@ -60,7 +60,7 @@ impl SadFlowConfig {
             return Err(OdometryError::Invalid(format!("outlier threshold {}", self.outlier_px)));
         }
         if w < self.region || h < self.region {
-            return Err(OdometryError::FrameSize {
+            return Err(OdometryError::TooSmall {
                 got_w: w,
                 got_h: h,
                 why: format!("the central region is {0}x{0}", self.region),
@@ -325,13 +325,7 @@ fn windows_kernel(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig, n: usi
 
 /// Every window's flow between `prev` and `cur`, row by row (window rows of the region).
 pub fn window_flows(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig) -> Result<Vec<WindowFlow>> {
-    if prev.size() != cur.size() {
-        return Err(OdometryError::FrameSize {
-            got_w: cur.width(),
-            got_h: cur.height(),
-            why: format!("the previous frame is {}x{}", prev.width(), prev.height()),
-        });
-    }
+    ocellus_image::check::same_size("frame (against the previous one)", cur.size(), prev.size())?;
     let n = cfg.check(prev.width(), prev.height())?;
     let mut out = Vec::with_capacity(n * n);
     windows_kernel(prev, cur, cfg, n, &mut out);

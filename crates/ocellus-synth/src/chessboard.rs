@@ -139,15 +139,7 @@ impl BoardCamera {
         seed: u64,
     ) -> Result<Plane<f32>> {
         if let Some(b) = background {
-            if b.size() != (self.width, self.height) {
-                return Err(SynthError::InvalidConfig(format!(
-                    "background is {}x{}, the camera {}x{}",
-                    b.width(),
-                    b.height(),
-                    self.width,
-                    self.height
-                )));
-            }
+            ocellus_image::check::same_size("background (against the camera)", b.size(), (self.width, self.height))?;
         }
         if !(1..=16).contains(&supersample) {
             return Err(SynthError::InvalidConfig(format!("supersample {supersample} must be 1..=16")));

@@ -2,7 +2,7 @@
 //! coordinates of an image point.
 
 use super::LogPolarMap;
-use crate::{FoveaError, Result};
+use crate::Result;
 use ocellus_image::Plane;
 use std::f64::consts::TAU;
 
@@ -11,14 +11,7 @@ impl LogPolarMap {
     /// cortical image bilinearly (cyclic across sectors) at its own (ring, sector)
     /// coordinates; pixels beyond rho_max (or inside an unsampled fovea) are 0.
     pub fn inverse(&self, cortex: &Plane<f32>) -> Result<Plane<f32>> {
-        if cortex.size() != (self.cfg.sectors, self.rows) {
-            return Err(FoveaError::Size {
-                got_w: cortex.width(),
-                got_h: cortex.height(),
-                want_w: self.cfg.sectors,
-                want_h: self.rows,
-            });
-        }
+        ocellus_image::check::same_size("cortical image", cortex.size(), (self.cfg.sectors, self.rows))?;
         let mut out = Plane::new(self.width, self.height);
         for y in 0..self.height {
             for x in 0..self.width {

@@ -535,10 +535,7 @@ impl LogPolarMap {
     }
 
     fn check_size(&self, w: usize, h: usize) -> Result<()> {
-        if (w, h) != (self.width, self.height) {
-            return Err(FoveaError::Size { got_w: w, got_h: h, want_w: self.width, want_h: self.height });
-        }
-        Ok(())
+        Ok(ocellus_image::check::same_size("image (against the map's)", (w, h), (self.width, self.height))?)
     }
 
     /// The cortical image of a grey image (grey levels as given: 0..255), `sectors` wide and
