@@ -15,11 +15,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut engine = SaliencyEngine::new(SaliencyConfig::ace2009(), w, h)?;
     let map = engine.process(&image)?.clone();
     let (mw, mh) = map.size();
-    let (cx, cy, peak) = map.argmax().ok_or("the saliency map is empty")?;
-    // A map cell covers w / mw x h / mh input pixels; report its centre.
-    let (px, py) = ((cx as f32 + 0.5) * w as f32 / mw as f32, (cy as f32 + 0.5) * h as f32 / mh as f32);
+    // The winning cell and its centre in image pixels (pixel centres at integers).
+    let peak = ocellus_image::location::peak(&map, (w, h)).ok_or("the saliency map is empty")?;
+    let ((cx, cy), [px, py]) = (peak.cell, peak.pixel);
     println!("{}: {w}x{h}, map {mw}x{mh}", path.display());
-    println!("most salient cell ({cx}, {cy}) = {peak:.4}, about ({px:.0}, {py:.0}) px in the image");
+    println!("most salient cell ({cx}, {cy}) = {:.4}, centred at ({px:.1}, {py:.1}) px in the image", peak.value);
     for (label, conspicuity) in engine.conspicuity_maps() {
         println!("  {label:<12} {:.4} at the peak", conspicuity.get(cx, cy));
     }

@@ -26,15 +26,8 @@ fn grey_level(name: &str, levels: usize) -> Plane<f32> {
 }
 
 fn argmax(p: &Plane<f32>) -> (usize, usize) {
-    let mut best = (f32::NEG_INFINITY, 0, 0);
-    for y in 0..p.height() {
-        for x in 0..p.width() {
-            if p.get(x, y) > best.0 {
-                best = (p.get(x, y), x, y);
-            }
-        }
-    }
-    (best.1, best.2)
+    let (x, y, _) = p.argmax().expect("a non-empty map");
+    (x, y)
 }
 
 #[test]

@@ -252,7 +252,7 @@ const CASES: &[Case] = &[
     c("bench attention --width 100", Error(&["does not use --width"])),
     c("bench geometry --image {D}/img.png", Error(&["does not use --image"])),
     c("bench logpolar --preset stb", Error(&["does not use --preset"])),
-    c("bench planning --backend scalar", Error(&["does not use --backend"])),
+    c("bench attention --backend scalar", Error(&["does not use --backend"])),
     c("bench saliency --backend quantum --frames 1", Error(&["quantum"])),
     c("bench saliency --image {D}/missing.png --frames 1", Error(&["missing.png"])),
     c("bench teleport", Usage(&["teleport"])),

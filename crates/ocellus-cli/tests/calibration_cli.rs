@@ -12,7 +12,7 @@ fn camera(path: &Path) -> toml::Value {
 }
 
 fn grey(path: &Path) -> ocellus_image::Plane<f32> {
-    ocellus_io::read_image(path).unwrap().to_luma8().map(|v| v as f32 / 255.0)
+    ocellus_io::read_image(path).unwrap().to_grey()
 }
 
 /// Largest distance of the corners of any board row from their least-squares line, pixels.

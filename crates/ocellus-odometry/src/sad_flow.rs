@@ -286,7 +286,7 @@ unsafe fn search_8x8_avx2(
 }
 
 /// The block search of every window with `cfg.backend`'s build: the 8x8 searches have
-/// hand-written SSE4.1 and AVX2 kernels (`_mm_sad_epu8`, `_mm_minpos_epu16`: the compiler
+/// hand-written SSE4.1 and AVX2 kernels (`mpsadbw`, `phminposuw`: the compiler
 /// does not find these from the scalar loop); other block sizes run the scalar search.
 fn windows_kernel(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig, n: usize, out: &mut Vec<WindowFlow>) {
     let (w, h) = prev.size();

@@ -1,11 +1,11 @@
 //! `ocellus bench logpolar`: the log-polar map per 640x480 frame on one core.
 
-use crate::bench::median;
+use super::timing::median;
 use anyhow::{Context, Result};
 use ocellus_fovea::logpolar::{Fields, LogPolarConfig, LogPolarMap, Scratch};
 use ocellus_fovea::register::{register, Mode, RegisterOptions};
 use ocellus_fovea::vergence::{vergence, VergenceOptions, VergenceTracker};
-use ocellus_image::Plane;
+use ocellus_image::{Backend, Plane};
 use serde_json::json;
 use std::time::Instant;
 
@@ -18,12 +18,13 @@ fn frame() -> Result<Plane<[u8; 3]>> {
 }
 
 /// Runs the benchmark: 128 log rings x 128 sectors (plus the fovea rings) about the centre.
-pub fn run(json_out: bool) -> Result<()> {
+pub fn run(json_out: bool, backend: Backend) -> Result<()> {
     let rgb = frame()?;
     let grey = rgb.map(|p| ((p[0] as u32 * 77 + p[1] as u32 * 150 + p[2] as u32 * 29 + 128) >> 8) as u8);
     let mut figures = serde_json::Map::new();
+    figures.insert("backend".into(), json!(backend.name()));
     for (name, fields) in [("pyramid", Fields::Pyramid), ("area", Fields::Area)] {
-        let cfg = LogPolarConfig { fields, ..LogPolarConfig::for_image(640, 480) };
+        let cfg = LogPolarConfig { fields, backend, ..LogPolarConfig::for_image(640, 480) };
         let mut build = Vec::new();
         let mut map = None;
         for _ in 0..5 {
@@ -72,12 +73,12 @@ pub fn run(json_out: bool) -> Result<()> {
     let mut t = Vec::new();
     for _ in 0..20 {
         let s = Instant::now();
-        vergence(&photo, &right, [300.0, 250.0], &VergenceOptions::default())?;
+        vergence(&photo, &right, [300.0, 250.0], &VergenceOptions { backend, ..VergenceOptions::default() })?;
         t.push(s.elapsed().as_secs_f64() * 1e3);
     }
     figures.insert("ms_vergence_65_disparities".into(), json!(median(&mut t)));
     // Tracking: each frame searches 4 px around the last disparity (9 candidates).
-    let mut tracker = VergenceTracker::new(VergenceOptions::default(), 4, 0.8)?;
+    let mut tracker = VergenceTracker::new(VergenceOptions { backend, ..VergenceOptions::default() }, 4, 0.8)?;
     tracker.update(&photo, &right, [300.0, 250.0])?;
     let mut t = Vec::new();
     for _ in 0..20 {

@@ -1,7 +1,7 @@
 //! `ocellus bench geometry`: DLT and Zhang calibration, triangulation, block matching and
 //! semi-global matching, one thread.
 
-use crate::bench::median;
+use super::timing::median;
 use anyhow::Result;
 use nalgebra::{Rotation3, Vector3};
 use ocellus_geometry::block_matching::{block_match, BlockMatching};
@@ -12,7 +12,7 @@ use ocellus_geometry::sgm::{Sgm, SgmMatcher, SgmPaths};
 use ocellus_geometry::triangulate::{n_view, two_view_seed};
 use ocellus_geometry::zhang::{calibrate, project_view, PlanarView, Pose, ZhangOptions};
 use ocellus_image::rng::SplitMix64;
-use ocellus_image::Plane;
+use ocellus_image::{Backend, Plane};
 use serde_json::json;
 use std::time::Instant;
 
@@ -21,7 +21,7 @@ fn ms(t: Instant) -> f64 {
 }
 
 /// Runs the benchmark; `reps` repetitions of each timing (median reported).
-pub fn run(json_out: bool, reps: usize) -> Result<()> {
+pub fn run(json_out: bool, backend: Backend, reps: usize) -> Result<()> {
     let k = Intrinsics { fx: 810.0, fy: 790.0, cx: 322.0, cy: 236.0, skew: 0.0 };
     let c1 = PinholeCamera {
         k,
@@ -70,14 +70,14 @@ pub fn run(json_out: bool, reps: usize) -> Result<()> {
     let mut t_bm: Vec<f64> = (0..reps.clamp(3, 10))
         .map(|_| {
             let t = Instant::now();
-            let _ = block_match(&left, &right, &BlockMatching::default());
+            let _ = block_match(&left, &right, &BlockMatching { backend, ..BlockMatching::default() });
             ms(t)
         })
         .collect();
     // SGM, steady state (the matcher's buffers reused), on the same pair.
     let mut t_sgm = Vec::new();
     for paths in [SgmPaths::Eight, SgmPaths::Four] {
-        let mut m = SgmMatcher::new(Sgm { paths, ..Sgm::default() }, w, h)?;
+        let mut m = SgmMatcher::new(Sgm { paths, backend, ..Sgm::default() }, w, h)?;
         m.compute(&left, &right)?;
         let mut t: Vec<f64> = (0..reps.clamp(3, 10))
             .map(|_| {
@@ -90,6 +90,7 @@ pub fn run(json_out: bool, reps: usize) -> Result<()> {
     }
     let mut t_zhang = zhang_times(reps, &mut rng);
     let v = json!({
+        "backend": backend.name(),
         "ms_dlt_100_points": median(&mut t_dlt),
         "ms_triangulate_100k_two_view_seed": median(&mut t_seed),
         "ms_triangulate_100k_two_view_svd": median(&mut t_nview),

@@ -1,8 +1,8 @@
 //! `ocellus bench attention`: the per-frame cost of surprise, chaos and attention on top of
 //! saliency, and end-to-end frames per second of `ocellus attend` from video files.
 
+use super::timing::{median, peak_rss_mb};
 use crate::attend::{self, AttendArgs, StreamOptions};
-use crate::bench::{median, peak_rss_mb};
 use crate::generate::scene;
 use anyhow::Result;
 use ocellus_attention::attention::Attention;

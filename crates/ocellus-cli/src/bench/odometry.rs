@@ -1,8 +1,9 @@
 //! `ocellus bench odometry`: visual odometry per frame on one core, seed and robust modes.
 
-use crate::bench::median;
+use super::timing::median;
 use crate::generate_ground::textures;
 use anyhow::Result;
+use ocellus_image::Backend;
 use ocellus_odometry::kinematics::Mount;
 use ocellus_odometry::sad_flow::{group_flows, SadFlowConfig};
 use ocellus_odometry::vo::{OdometryConfig, VisualOdometry};
@@ -11,7 +12,7 @@ use serde_json::json;
 use std::time::Instant;
 
 /// Runs the benchmark on 40 generated 640x480 frames of each texture (rendering excluded).
-pub fn run(json_out: bool) -> Result<()> {
+pub fn run(json_out: bool, backend: Backend) -> Result<()> {
     let tex = textures()?;
     let mut frames = Vec::new();
     for texture in [GroundTexture::Brick, GroundTexture::Grass, GroundTexture::Gravel] {
@@ -24,7 +25,9 @@ pub fn run(json_out: bool) -> Result<()> {
     let mut t_step = Vec::new();
     let mut t_robust = Vec::new();
     for _ in 0..3 {
-        let mut vo = VisualOdometry::new(OdometryConfig::robust(0.3, 600.0, Mount { right_m: 0.0, forward_m: 0.05 }))?;
+        let mut cfg = OdometryConfig::robust(0.3, 600.0, Mount { right_m: 0.0, forward_m: 0.05 });
+        cfg.flow.backend = backend;
+        let mut vo = VisualOdometry::new(cfg)?;
         for f in &frames {
             let t = Instant::now();
             vo.step(f)?;
@@ -32,10 +35,12 @@ pub fn run(json_out: bool) -> Result<()> {
         }
         for w in frames.windows(2) {
             let t = Instant::now();
-            let _ = group_flows(&w[0], &w[1], &SadFlowConfig::default());
+            let _ = group_flows(&w[0], &w[1], &SadFlowConfig { backend, ..SadFlowConfig::default() });
             t_flow.push(t.elapsed().as_secs_f64() * 1e3);
         }
-        let mut vo = VisualOdometry::new(OdometryConfig::seed(0.3, 600.0, Mount { right_m: 0.0, forward_m: 0.05 }))?;
+        let mut cfg = OdometryConfig::seed(0.3, 600.0, Mount { right_m: 0.0, forward_m: 0.05 });
+        cfg.flow.backend = backend;
+        let mut vo = VisualOdometry::new(cfg)?;
         for f in &frames {
             let t = Instant::now();
             vo.step(f)?;
@@ -45,6 +50,7 @@ pub fn run(json_out: bool) -> Result<()> {
     let step = median(&mut t_step);
     let robust = median(&mut t_robust);
     let v = json!({
+        "backend": backend.name(),
         "ms_per_frame_1thread_seed": step,
         "fps_1thread_seed": 1e3 / step.max(1e-9),
         "ms_per_frame_1thread_robust": robust,

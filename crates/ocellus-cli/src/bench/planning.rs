@@ -1,20 +1,20 @@
 //! `ocellus bench planning`: the cost of one view-direction decision (19 candidate pans, a
 //! 40x30 surprise map, 4 landmarks), one thread.
 
-use crate::bench::median;
+use super::timing::median;
 use anyhow::Result;
 use nalgebra::{Matrix2, Vector2};
 use ocellus_attention::planning::{PlannerConfig, ViewPlanner};
 use ocellus_estimation::bearing::Landmark;
 use ocellus_image::rng::SplitMix64;
-use ocellus_image::Plane;
+use ocellus_image::{Backend, Plane};
 use serde_json::json;
 use std::time::Instant;
 
 /// Runs the benchmark: `n` decisions, alternating a calm and an eventful surprise map.
-pub fn run(json_out: bool, n: usize) -> Result<()> {
+pub fn run(json_out: bool, backend: Backend, n: usize) -> Result<()> {
     let landmarks = [(3.0, 2.5), (5.5, 0.0), (9.0, 2.5), (11.0, 0.0)].map(|(x, y)| Landmark { x, y }).to_vec();
-    let mut planner = ViewPlanner::new(PlannerConfig::default(), landmarks)?;
+    let mut planner = ViewPlanner::new(PlannerConfig { backend, ..PlannerConfig::default() }, landmarks)?;
     // Weak background surprise everywhere (every cell takes part), and a surprising region.
     let mut rng = SplitMix64::new(3);
     let calm = Plane::from_fn(40, 30, |_, _| (0.3 * rng.unit()) as f32);
@@ -38,6 +38,7 @@ pub fn run(json_out: bool, n: usize) -> Result<()> {
         }
     }
     let v = json!({
+        "backend": backend.name(),
         "us_per_decision_1thread": median(&mut times),
         "candidates": planner.config().candidates_deg.len(),
         "surprise_map": [40, 30],

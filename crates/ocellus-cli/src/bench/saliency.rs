@@ -1,0 +1,164 @@
+//! `ocellus bench saliency`: per-preset milliseconds per frame on one core, with the stage
+//! breakdown, and frames per second on all cores.
+
+use super::timing::{median, peak_rss_mb};
+use super::BenchArgs;
+use anyhow::Result;
+use ocellus_attention::{SaliencyConfig, SaliencyEngine};
+use ocellus_image::convert::{merge_rgb8, split_rgb8, RgbImage};
+use ocellus_image::resample::{resize, ResampleMethod};
+use ocellus_image::Backend;
+use serde_json::json;
+use std::time::{Duration, Instant};
+
+fn frames(a: &BenchArgs) -> Result<Vec<RgbImage>> {
+    let (width, height) = a.size();
+    // Decoded as every command decodes (format checks, memory budget); resized bilinearly
+    // channel by channel (the content only has to be real photographs).
+    let decoded: Vec<RgbImage> = match &a.image {
+        Some(p) => vec![crate::budget::read_image(p)?],
+        None => crate::assets::IMAGES.iter().map(|(n, _)| crate::assets::decode(n)).collect::<Result<_>>()?,
+    };
+    let (w, h) = (width as usize, height as usize);
+    decoded
+        .iter()
+        .map(|d| {
+            let [r, g, b] = split_rgb8(&d.to_u8()).map(|c| resize(Backend::Auto, &c, w, h, ResampleMethod::Bilinear));
+            Ok(RgbImage::U8(merge_rgb8([&r?, &g?, &b?])))
+        })
+        .collect()
+}
+
+fn bench_preset(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize) -> Result<serde_json::Value> {
+    let (w, h) = frames[0].size();
+    let mut e = SaliencyEngine::new(cfg.clone(), w, h)?;
+    for f in frames.iter().cycle().take(20) {
+        e.process(f)?;
+    }
+    let mut total = Vec::with_capacity(n);
+    let mut stages: Vec<Vec<f64>> = (0..6).map(|_| Vec::with_capacity(n)).collect();
+    for f in frames.iter().cycle().take(n) {
+        let t = Instant::now();
+        e.process(f)?;
+        total.push(t.elapsed().as_secs_f64() * 1e3);
+        for (k, (_, d)) in e.timings().stages().iter().enumerate() {
+            stages[k].push(d.as_secs_f64() * 1e3);
+        }
+    }
+    let mean_ms = total.iter().sum::<f64>() / total.len() as f64;
+    let ms = median(&mut total);
+    let names = e.timings().stages().map(|s| s.0);
+    let stage_ms: serde_json::Map<String, serde_json::Value> =
+        names.iter().zip(stages.iter_mut()).map(|(n, v)| (n.to_string(), json!(median(v)))).collect();
+
+    // Throughput with 1 thread and with all threads, same harness, alternated three times
+    // so that both see the same machine load; medians.
+    let threads = rayon::current_num_threads();
+    let (mut one, mut all) = (Vec::new(), Vec::new());
+    for _ in 0..3 {
+        one.push(throughput(cfg, frames, 1, n)?);
+        all.push(throughput(cfg, frames, threads, n.max(threads * 100))?);
+    }
+    let (fps_1, fps_all) = (median(&mut one), median(&mut all));
+    Ok(json!({
+        "ms_per_frame_1thread": ms,
+        "ms_per_frame_1thread_mean": mean_ms,
+        "fps_1thread": fps_1,
+        "threads": threads,
+        "fps_all_threads": fps_all,
+        "speedup_all_threads": fps_all / fps_1,
+        "stage_ms_1thread": stage_ms,
+        "frames_timed": n,
+    }))
+}
+
+/// Frames per second of `threads` engines (one per thread, built and warmed up before the
+/// clock starts) sharing `n` frames: thread t takes frames t, t + T, ..., as a pipeline that
+/// spreads frames over workers would.
+fn throughput(cfg: &SaliencyConfig, frames: &[RgbImage], threads: usize, n: usize) -> Result<f64> {
+    let (w, h) = frames[0].size();
+    let barrier = std::sync::Barrier::new(threads + 1);
+    let elapsed = std::thread::scope(|scope| -> Result<Duration> {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                let barrier = &barrier;
+                scope.spawn(move || -> Result<()> {
+                    let engine = SaliencyEngine::new(cfg.clone(), w, h);
+                    let warm = engine.and_then(|mut e| {
+                        for f in frames.iter().cycle().take(10) {
+                            e.process(f)?;
+                        }
+                        Ok(e)
+                    });
+                    // Reach the barrier whatever happened, so the timer thread never waits forever.
+                    barrier.wait();
+                    let mut e = warm?;
+                    for i in (t..n).step_by(threads) {
+                        e.process(&frames[i % frames.len()])?;
+                    }
+                    Ok(())
+                })
+            })
+            .collect();
+        barrier.wait();
+        let t0 = Instant::now();
+        for h in handles {
+            h.join().map_err(|_| anyhow::anyhow!("benchmark thread panicked"))??;
+        }
+        Ok(t0.elapsed())
+    })?;
+    Ok(n as f64 / elapsed.as_secs_f64())
+}
+
+/// Runs `ocellus bench saliency` with `backend`'s kernels, `n` frames per preset.
+pub fn run(a: &BenchArgs, backend: Backend, n: usize) -> Result<()> {
+    let (width, height) = a.size();
+    let frames = frames(a)?;
+    let presets = if a.preset.is_empty() {
+        SaliencyConfig::PRESETS.iter().map(|s| s.to_string()).collect()
+    } else {
+        a.preset.clone()
+    };
+    let mut out = serde_json::Map::new();
+    out.insert("frame_width".into(), json!(width));
+    out.insert("frame_height".into(), json!(height));
+    out.insert("threads".into(), json!(rayon::current_num_threads()));
+    out.insert("backend".into(), json!(backend.name()));
+    for p in &presets {
+        let mut cfg = SaliencyConfig::preset(p)?;
+        cfg.backend = backend;
+        out.insert(p.clone(), bench_preset(&cfg, &frames, n)?);
+    }
+    out.insert("peak_rss_mb".into(), json!(peak_rss_mb()));
+    let v = serde_json::Value::Object(out);
+    if a.json {
+        outln!("{v}");
+        return Ok(());
+    }
+    outln!(
+        "saliency benchmark: {}x{}, backend {}, {} threads",
+        width,
+        height,
+        backend.name(),
+        rayon::current_num_threads()
+    );
+    for p in &presets {
+        let r = &v[p];
+        outln!(
+            "{p:>8}: {:.3} ms/frame on 1 thread (median of {}), {:.0} fps on all threads ({:.2}x)",
+            r["ms_per_frame_1thread"].as_f64().unwrap_or(0.0),
+            n,
+            r["fps_all_threads"].as_f64().unwrap_or(0.0),
+            r["speedup_all_threads"].as_f64().unwrap_or(0.0)
+        );
+        if let Some(st) = r["stage_ms_1thread"].as_object() {
+            for (k, ms) in st {
+                outln!("          {k:<20} {:.3} ms", ms.as_f64().unwrap_or(0.0));
+            }
+        }
+    }
+    if let Some(m) = v["peak_rss_mb"].as_f64() {
+        outln!("peak resident memory: {m:.1} MiB");
+    }
+    Ok(())
+}
