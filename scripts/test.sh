@@ -17,6 +17,8 @@ examples=(
   "ocellus-geometry stereo_depth"
   "ocellus-fovea logpolar_register"
   "ocellus-odometry floor_odometry"
+  "ocellus-sim corridor_event"
+  "ocellus-eval mit1003_scores"
 )
 ran=0
 for e in "${examples[@]}"; do
