@@ -92,6 +92,22 @@ fn bench_prints_json_with_named_units() {
 }
 
 #[test]
+fn bench_names_the_backend_it_ran_and_times_resampling() {
+    let run = |args: &[&str]| -> serde_json::Value {
+        let o = ocellus().args(args).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let v = run(&["bench", "planning", "--json", "--frames", "100", "--backend", "scalar"]);
+    assert_eq!(v["backend"], "scalar");
+    let v = run(&["bench", "tracking", "--json"]);
+    assert_eq!(v["particles"], 1_000_000);
+    for s in ["systematic", "stratified", "multinomial", "residual"] {
+        assert!(v[format!("ms_resample_{s}_1e6")].as_f64().unwrap() > 0.0, "{s}");
+    }
+}
+
+#[test]
 fn demo_runs_on_built_in_images() {
     let out = tmpdir("demo");
     let o = ocellus().arg("demo").arg("--out").arg(&out).output().unwrap();

@@ -3,6 +3,10 @@
 //! - [`gaussian`]: the KL divergence between multivariate normal distributions, in bits.
 //! - [`bearing`]: the extended Kalman filter update of a 2D position from bearings to known
 //!   landmarks (the self-localization task of view planning, SPEC 2.3).
+//! - [`particle_filter`]: generic SIS/SIR particle filters with log weights, the effective
+//!   sample size and seeded, thread-count independent randomness (SPEC 7.1);
+//! - [`resampling`]: systematic (the seed's Algorithm 2), stratified, multinomial and residual
+//!   resampling.
 //!
 //! Conventions: positions in metres in a right-handed plane frame (x forward along the
 //! corridor, y to the left); angles in radians, counter-clockwise from +x.
@@ -21,6 +25,8 @@
 
 pub mod bearing;
 pub mod gaussian;
+pub mod particle_filter;
+pub mod resampling;
 
 use thiserror::Error;
 

@@ -7,6 +7,7 @@ mod odometry;
 mod planning;
 mod saliency;
 mod timing;
+mod tracking;
 
 use crate::ranges;
 use anyhow::{bail, Result};
@@ -32,6 +33,8 @@ pub enum Target {
     /// The log-polar map, 640x480 grey and RGB to 128 rings x 128 sectors on one core, and
     /// the table construction.
     Logpolar,
+    /// Particle filters: resampling 10^6 particles with each scheme on one core.
+    Tracking,
 }
 
 /// Arguments of `ocellus bench`.
@@ -82,6 +85,7 @@ impl BenchArgs {
             Target::Attention => &["--frames"],
             Target::Planning => &["--frames", "--backend"],
             Target::Geometry | Target::Odometry | Target::Logpolar => &["--backend"],
+            Target::Tracking => &[],
         };
         let unused: Vec<&str> = given.iter().filter(|(n, g)| *g && !used.contains(n)).map(|(n, _)| *n).collect();
         if !unused.is_empty() {
@@ -110,6 +114,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         Target::Geometry => return geometry::run(a.json, backend, 5),
         Target::Odometry => return odometry::run(a.json, backend),
         Target::Logpolar => return logpolar::run(a.json, backend),
+        Target::Tracking => return tracking::run(a.json),
         Target::Saliency => {}
     }
     saliency::run(&a, backend, n)
