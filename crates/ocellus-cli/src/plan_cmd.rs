@@ -106,23 +106,10 @@ fn angles(records: &[StepRecord]) -> Vec<(f64, f64)> {
     records.iter().map(|r| (r.step as f64, r.decision.pan_deg)).collect()
 }
 
-/// The corridor's photographs and textures from the built-in assets.
-fn corridor_images() -> Result<CorridorImages> {
-    let read = crate::assets::decode;
-    Ok(CorridorImages {
-        astronaut: read("astronaut.png")?,
-        brick: read("brick.png")?,
-        gravel: read("gravel.png")?,
-        coffee: read("coffee.png")?,
-        rocket: read("rocket.jpg")?,
-        chelsea: read("chelsea.png")?,
-    })
-}
-
 /// Runs the subcommand.
 pub fn run(a: PlanArgs) -> Result<()> {
     let What::Corridor(a) = a.what;
-    let world = corridor_sim::corridor(&corridor_images()?)?;
+    let world = corridor_sim::corridor(&CorridorImages::load(crate::assets::decode)?)?;
     let cfg = RunConfig { steps: a.steps, event: a.event, seed: a.seed, ..RunConfig::default() };
     let frames = a.out.join("frames");
     crate::output_files::create_dir(&frames)?;

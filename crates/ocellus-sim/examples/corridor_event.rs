@@ -7,15 +7,7 @@ use ocellus_sim::corridor_experiment::{corridor, run, CorridorImages, RunConfig}
 use ocellus_sim::SimError;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let read = |n: &str| ocellus_io::read_image(ocellus_testdata::asset(n));
-    let images = CorridorImages {
-        astronaut: read("astronaut.png")?,
-        brick: read("brick.png")?,
-        gravel: read("gravel.png")?,
-        coffee: read("coffee.png")?,
-        rocket: read("rocket.jpg")?,
-        chelsea: read("chelsea.png")?,
-    };
+    let images = CorridorImages::load(|n| ocellus_io::read_image(ocellus_testdata::asset(n)))?;
     let world = corridor(&images)?;
     let cfg = RunConfig { steps: 8, event: true, ..RunConfig::default() };
     let calm = run(&RunConfig { event: false, ..cfg.clone() }, &world, |_, _| Ok::<(), SimError>(()))?;

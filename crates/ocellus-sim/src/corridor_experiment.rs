@@ -104,6 +104,21 @@ pub struct CorridorImages {
     pub chelsea: RgbImage,
 }
 
+impl CorridorImages {
+    /// The images by the names of the built-in assets (`astronaut.png`, `brick.png`,
+    /// `gravel.png`, `coffee.png`, `rocket.jpg`, `chelsea.png`), each read by `read`.
+    pub fn load<E>(mut read: impl FnMut(&str) -> std::result::Result<RgbImage, E>) -> std::result::Result<Self, E> {
+        Ok(Self {
+            astronaut: read("astronaut.png")?,
+            brick: read("brick.png")?,
+            gravel: read("gravel.png")?,
+            coffee: read("coffee.png")?,
+            rocket: read("rocket.jpg")?,
+            chelsea: read("chelsea.png")?,
+        })
+    }
+}
+
 /// A `w` x `h` crop at (`x`, `y`) of `img`, clamped to the image.
 fn crop(img: &RgbImage, x: usize, y: usize, w: usize, h: usize) -> RgbImage {
     let (iw, ih) = img.size();

@@ -9,15 +9,7 @@
 //! ```
 //! use ocellus_sim::corridor_experiment::{corridor, run, CorridorImages, RunConfig};
 //! use ocellus_sim::SimError;
-//! let read = |n: &str| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap();
-//! let images = CorridorImages {
-//!     astronaut: read("astronaut.png"),
-//!     brick: read("brick.png"),
-//!     gravel: read("gravel.png"),
-//!     coffee: read("coffee.png"),
-//!     rocket: read("rocket.jpg"),
-//!     chelsea: read("chelsea.png"),
-//! };
+//! let images = CorridorImages::load(|n| ocellus_io::read_image(ocellus_testdata::asset(n))).unwrap();
 //! let world = corridor(&images)?;
 //! let cfg = RunConfig { steps: 2, ..Default::default() };
 //! let records = run(&cfg, &world, |_, _| Ok::<(), SimError>(()))?;

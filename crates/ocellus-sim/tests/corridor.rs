@@ -6,15 +6,7 @@
 use ocellus_sim::corridor_experiment::{corridor, run, CorridorImages, RunConfig};
 
 fn images() -> CorridorImages {
-    let read = |n: &str| ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap();
-    CorridorImages {
-        astronaut: read("astronaut.png"),
-        brick: read("brick.png"),
-        gravel: read("gravel.png"),
-        coffee: read("coffee.png"),
-        rocket: read("rocket.jpg"),
-        chelsea: read("chelsea.png"),
-    }
+    CorridorImages::load(|n| ocellus_io::read_image(ocellus_testdata::asset(n))).unwrap()
 }
 
 /// The step callback's error type of these runs.
