@@ -4,7 +4,9 @@
 //!
 //! - [`colour`]: HSV colour histograms (Pérez et al. 2002), a frame binned once, and the
 //!   seed's likelihood `BC(inner, model) - BC(inner, outer)` of an image circle from sample
-//!   points on the disc and on a ring just outside it (SPEC 7.2).
+//!   points on the disc and on a ring just outside it (SPEC 7.2);
+//! - [`ball`]: the 3D ball (position and velocity, constant velocity with gravity) projected
+//!   through a calibrated camera with distortion, as a particle-filter model (SPEC 7.3).
 //!
 //! Image conventions are `ocellus-image`'s: x right, y down, pixel centres at integers.
 //!
@@ -24,6 +26,7 @@
 //! # Ok::<(), ocellus_tracking::TrackingError>(())
 //! ```
 
+pub mod ball;
 pub mod colour;
 
 /// Errors of the tracking crate.
