@@ -101,7 +101,11 @@ fn bench_names_the_backend_it_ran_and_times_resampling() {
     let v = run(&["bench", "planning", "--json", "--frames", "100", "--backend", "scalar"]);
     assert_eq!(v["backend"], "scalar");
     let v = run(&["bench", "tracking", "--json"]);
-    assert_eq!(v["particles"], 1_000_000);
+    assert_eq!(v["particles_resampled"], 1_000_000);
+    for n in ["1e2", "1e3", "1e4", "1e5"] {
+        assert!(v[format!("ms_sir_step_{n}_1thread")].as_f64().unwrap() > 0.0, "{n}");
+    }
+    assert!(v["speedup_all_threads_1e4"].as_f64().unwrap() > 0.0);
     for s in ["systematic", "stratified", "multinomial", "residual"] {
         assert!(v[format!("ms_resample_{s}_1e6")].as_f64().unwrap() > 0.0, "{s}");
     }

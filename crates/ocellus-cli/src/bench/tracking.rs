@@ -1,13 +1,75 @@
-//! `ocellus bench tracking`: the particle-filter figures that exist so far: resampling 10^6
-//! particles with each scheme on one core (the colour-likelihood step of issue 16 is not
-//! built yet, so no per-frame figure is printed).
+//! `ocellus bench tracking`: one SIR step of the 3D ball tracker on a 640x480 frame (binning
+//! the frame, proposing and weighing every particle by the colour likelihood, resampling) for
+//! 10^2..10^5 particles on one thread and on all, and resampling 10^6 particles with each
+//! scheme.
 
 use super::timing::median;
 use anyhow::Result;
+use nalgebra::{Matrix3, Vector3};
+use ocellus_estimation::particle_filter::{FilterConfig, ParticleFilter};
 use ocellus_estimation::resampling::Resampler;
+use ocellus_geometry::camera::{Intrinsics, PinholeCamera};
+use ocellus_geometry::distortion::Distortion;
 use ocellus_image::rng::SplitMix64;
+use ocellus_image::Plane;
+use ocellus_tracking::ball::{project_ball, BallModel, BallState};
+use ocellus_tracking::colour::{BinnedFrame, Circle, ColourModel};
 use serde_json::json;
 use std::time::Instant;
+
+/// The built-in astronaut photo stretched to 640x480 with an orange ball (5 cm at 2 m).
+fn scene() -> Result<(Plane<[u8; 3]>, BallModel, Vector3<f64>)> {
+    let photo = crate::assets::decode("astronaut.png")?.to_u8();
+    let k = Intrinsics { fx: 600.0, fy: 600.0, cx: 319.5, cy: 239.5, skew: 0.0 };
+    let camera = PinholeCamera { k, r: Matrix3::identity(), t: Vector3::zeros() };
+    let distortion = Distortion { k1: -0.12, k2: 0.02, k3: 0.0, p1: 0.0, p2: 0.0 };
+    let ball = Vector3::new(0.2, -0.1, 2.0);
+    let c = project_ball(&camera, &distortion, &ball, 0.05).ok_or_else(|| anyhow::anyhow!("ball out of view"))?;
+    let (pw, ph) = photo.size();
+    let frame = Plane::from_fn(640, 480, |x, y| {
+        if (x as f64 - c.x).powi(2) + (y as f64 - c.y).powi(2) <= c.r * c.r {
+            [245, 120, 25]
+        } else {
+            photo.get(x * pw / 640, y * ph / 480)
+        }
+    });
+    let colour = ColourModel::from_patch(&frame, Circle { r: 0.8 * c.r, ..c })?;
+    let model =
+        BallModel { camera, distortion, radius_m: 0.05, dt_s: 1.0 / 30.0, accel_sigma: 3.0, gravity: [0.0; 3], colour };
+    Ok((frame, model, ball))
+}
+
+/// Median milliseconds of one SIR step (binning included) with `n` particles on `threads`.
+fn sir_step_ms(
+    n: usize,
+    threads: usize,
+    frame: &Plane<[u8; 3]>,
+    model: &BallModel,
+    ball: &Vector3<f64>,
+) -> Result<f64> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+    pool.install(|| -> Result<f64> {
+        let mut rng = SplitMix64::new(1);
+        let particles: Vec<BallState> = (0..n)
+            .map(|_| BallState {
+                position: [ball.x + 0.03 * rng.normal(), ball.y + 0.03 * rng.normal(), ball.z + 0.1 * rng.normal()],
+                velocity: [0.3 * rng.normal(), 0.3 * rng.normal(), 0.3 * rng.normal()],
+            })
+            .collect();
+        let cfg = FilterConfig { resample_below: 1.0, ..FilterConfig::default() };
+        let mut pf = ParticleFilter::new(cfg, particles)?;
+        let mut binned = BinnedFrame::default();
+        let reps = (200_000 / n).clamp(5, 200);
+        let mut t = Vec::with_capacity(reps);
+        for _ in 0..reps {
+            let s = Instant::now();
+            binned.update(frame);
+            pf.step(model, &binned)?;
+            t.push(s.elapsed().as_secs_f64() * 1e3);
+        }
+        Ok(median(&mut t))
+    })
+}
 
 /// Runs the benchmark.
 pub fn run(json_out: bool) -> Result<()> {
@@ -19,7 +81,26 @@ pub fn run(json_out: bool) -> Result<()> {
     let w: Vec<f64> = raw.iter().map(|v| v / s).collect();
     let mut out = Vec::with_capacity(n);
     let mut figures = serde_json::Map::new();
-    figures.insert("particles".into(), json!(n));
+    let (frame, model, ball) = scene()?;
+    let threads = rayon::current_num_threads();
+    figures.insert("threads".into(), json!(threads));
+    let mut frame_bin = BinnedFrame::default();
+    let mut tb: Vec<f64> = (0..20)
+        .map(|_| {
+            let s = Instant::now();
+            frame_bin.update(&frame);
+            s.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    figures.insert("ms_bin_frame_640x480".into(), json!(median(&mut tb)));
+    for (p, key) in [(100, "1e2"), (1000, "1e3"), (10_000, "1e4"), (100_000, "1e5")] {
+        figures.insert(format!("ms_sir_step_{key}_1thread"), json!(sir_step_ms(p, 1, &frame, &model, &ball)?));
+    }
+    let one = sir_step_ms(10_000, 1, &frame, &model, &ball)?;
+    let all = sir_step_ms(10_000, threads, &frame, &model, &ball)?;
+    figures.insert("ms_sir_step_1e4_all_threads".into(), json!(all));
+    figures.insert("speedup_all_threads_1e4".into(), json!(one / all));
+    figures.insert("particles_resampled".into(), json!(n));
     for (name, r) in [
         ("systematic", Resampler::Systematic),
         ("stratified", Resampler::Stratified),
@@ -40,6 +121,18 @@ pub fn run(json_out: bool) -> Result<()> {
         outln!("{v}");
         return Ok(());
     }
+    outln!(
+        "one SIR step of the ball tracker on a 640x480 frame (binning {:.2} ms), one thread:",
+        v["ms_bin_frame_640x480"].as_f64().unwrap_or(0.0)
+    );
+    for key in ["1e2", "1e3", "1e4", "1e5"] {
+        outln!("  {key:>4} particles  {:.3} ms", v[format!("ms_sir_step_{key}_1thread")].as_f64().unwrap_or(0.0));
+    }
+    outln!(
+        "  1e4 particles on {threads} threads: {:.3} ms ({:.2}x)",
+        v["ms_sir_step_1e4_all_threads"].as_f64().unwrap_or(0.0),
+        v["speedup_all_threads_1e4"].as_f64().unwrap_or(0.0)
+    );
     outln!("resampling {n} particles on one thread (median of 11):");
     for name in ["systematic", "stratified", "multinomial", "residual"] {
         outln!("  {name:<12} {:.2} ms", v[format!("ms_resample_{name}_1e6")].as_f64().unwrap_or(0.0));
