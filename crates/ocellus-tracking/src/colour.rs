@@ -40,25 +40,41 @@ pub const SAMPLES: usize = 64;
 pub const RING: (f64, f64) = (1.05, 1.5);
 
 /// The histogram bin of an 8-bit RGB pixel.
-pub fn bin_of([r, g, b]: [u8; 3]) -> u8 {
+pub fn bin_of(rgb: [u8; 3]) -> u8 {
+    bin_with(rgb, &reciprocals())
+}
+
+/// `1 / k` for k = 0..=255 (0 for 0): the divisions of the HSV conversion become
+/// multiplications, which is most of the cost of binning a frame.
+fn reciprocals() -> [f32; 256] {
+    std::array::from_fn(|k| if k == 0 { 0.0 } else { 1.0 / k as f32 })
+}
+
+#[inline(always)]
+fn bin_with([r, g, b]: [u8; 3], inv: &[f32; 256]) -> u8 {
     let (mx, mn) = (r.max(g).max(b), r.min(g).min(b));
-    let v = mx as f32 / 255.0;
-    let delta = (mx - mn) as f32;
-    let s = if mx > 0 { delta / mx as f32 } else { 0.0 };
+    let v = mx as f32 * (1.0 / 255.0);
+    let delta = mx - mn;
+    let s = delta as f32 * inv[mx as usize];
     if s <= MIN_SATURATION || v <= MIN_VALUE {
         let k = ((v * VALUE_BINS as f32) as usize).min(VALUE_BINS - 1);
         return (HUE_BINS * SATURATION_BINS + k) as u8;
     }
-    let (r, g, b) = (r as f32, g as f32, b as f32);
-    // Hue in sextants [0, 6).
-    let h = if mx as f32 == r {
-        ((g - b) / delta).rem_euclid(6.0)
-    } else if mx as f32 == g {
-        (b - r) / delta + 2.0
+    // Hue in sextants [0, 6), as sextant * delta + offset over delta.
+    let (r, g, b, d) = (r as i32, g as i32, b as i32, delta as i32);
+    let num = if mx as i32 == r {
+        if g >= b {
+            g - b
+        } else {
+            6 * d + g - b
+        }
+    } else if mx as i32 == g {
+        2 * d + b - r
     } else {
-        (r - g) / delta + 4.0
+        4 * d + r - g
     };
-    let hb = ((h / 6.0 * HUE_BINS as f32) as usize).min(HUE_BINS - 1);
+    let h = num as f32 * inv[delta as usize];
+    let hb = ((h * (HUE_BINS as f32 / 6.0)) as usize).min(HUE_BINS - 1);
     let sb = ((s * SATURATION_BINS as f32) as usize).min(SATURATION_BINS - 1);
     (hb * SATURATION_BINS + sb) as u8
 }
@@ -92,9 +108,10 @@ impl BinnedFrame {
     pub fn update(&mut self, frame: &Plane<[u8; 3]>) {
         let (w, h) = frame.size();
         self.bins.resize(w, h);
+        let inv = reciprocals();
         for y in 0..h {
             for (o, &p) in self.bins.row_mut(y).iter_mut().zip(frame.row(y)) {
-                *o = bin_of(p);
+                *o = bin_with(p, &inv);
             }
         }
     }
