@@ -83,9 +83,12 @@ pub struct ParticleFilter<S> {
     particles: Vec<S>,
     log_w: Vec<f64>,
     steps: u64,
-    // Reused per step.
+    // Reused per step: incremental log weights, normalized weights, parents, and the next
+    // generation while resampling.
+    increments: Vec<f64>,
     weights: Vec<f64>,
     parents: Vec<usize>,
+    next: Vec<S>,
 }
 
 /// A generator for (seed, step, stream): SplitMix64 of a mixed key, so streams do not overlap
@@ -123,8 +126,10 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
             particles,
             log_w: vec![-(n as f64).ln(); n],
             steps: 0,
+            increments: Vec::new(),
             weights: Vec::new(),
             parents: Vec::new(),
+            next: Vec::new(),
         })
     }
 
@@ -190,46 +195,36 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
     /// target again.
     pub fn step<M: Model<State = S>>(&mut self, model: &M, z: &M::Observation) -> Result<StepReport> {
         let (seed, step) = (self.cfg.seed, self.steps);
-        let updated: Vec<(S, f64)> = self
-            .particles
-            .par_iter()
-            .enumerate()
-            .map(|(i, prev)| {
-                let mut rng = stream(seed, step, i as u64);
-                let d = model.propose(prev, z, &mut rng);
-                let ll = model.log_likelihood(&d.state, z);
-                (d.state, ll + d.log_prior_over_proposal)
-            })
-            .collect();
+        let n = self.particles.len();
+        // Each particle is moved and weighed in place: no allocation per step.
+        self.increments.resize(n, 0.0);
+        self.particles.par_iter_mut().zip(self.increments.par_iter_mut()).enumerate().for_each(|(i, (p, inc))| {
+            let mut rng = stream(seed, step, i as u64);
+            let d = model.propose(p, z, &mut rng);
+            *inc = model.log_likelihood(&d.state, z) + d.log_prior_over_proposal;
+            *p = d.state;
+        });
         self.steps += 1;
-        let n = updated.len();
-        let mut increments = Vec::with_capacity(n);
-        self.particles.clear();
-        for (s, inc) in updated {
-            if inc.is_nan() {
-                return Err(EstimationError::InvalidInput("the model gave a NaN log weight".into()));
-            }
-            self.particles.push(s);
-            increments.push(inc);
+        if self.increments.iter().any(|v| v.is_nan()) {
+            return Err(EstimationError::InvalidInput("the model gave a NaN log weight".into()));
         }
-        let weighted: Vec<f64> = self.log_w.iter().zip(&increments).map(|(w, i)| w + i).collect();
-        let total = log_sum_exp(&weighted);
-        // Mean incremental weight under the previous weights: sum_i w_i' exp(inc_i).
-        let log_evidence = total;
-        if total == f64::NEG_INFINITY || total.is_nan() || total == f64::INFINITY {
+        for (w, inc) in self.log_w.iter_mut().zip(&self.increments) {
+            *w += inc;
+        }
+        // The log evidence: log sum_i w_i' exp(inc_i), the previous weights being normalized.
+        let total = log_sum_exp(&self.log_w);
+        if !total.is_finite() {
             let lw = -(n as f64).ln();
             self.log_w.iter_mut().for_each(|l| *l = lw);
             return Ok(StepReport { ess: n as f64, resampled: false, log_evidence: f64::NEG_INFINITY });
         }
-        for (l, w) in self.log_w.iter_mut().zip(&weighted) {
-            *l = w - total;
-        }
+        self.log_w.iter_mut().for_each(|l| *l -= total);
         let ess = self.ess();
         let resampled = ess < self.cfg.resample_below * n as f64;
         if resampled {
             self.resample()?;
         }
-        Ok(StepReport { ess, resampled, log_evidence })
+        Ok(StepReport { ess, resampled, log_evidence: total })
     }
 
     /// Resamples now with the configured scheme; the weights become equal.
@@ -242,8 +237,9 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
         self.weights.iter_mut().for_each(|w| *w /= s);
         let mut rng = stream(self.cfg.seed, self.steps, u64::MAX);
         self.cfg.resampler.resample(&self.weights, &mut rng, &mut self.parents)?;
-        let next: Vec<S> = self.parents.iter().map(|&p| self.particles[p].clone()).collect();
-        self.particles = next;
+        self.next.clear();
+        self.next.extend(self.parents.iter().map(|&p| self.particles[p].clone()));
+        std::mem::swap(&mut self.particles, &mut self.next);
         let lw = -(n as f64).ln();
         self.log_w.iter_mut().for_each(|l| *l = lw);
         Ok(())

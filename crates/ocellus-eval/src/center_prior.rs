@@ -9,6 +9,7 @@
 //! `center_sigma_frac * max(width, height)`.
 
 use crate::{EvalError, Result};
+use ocellus_image::filter::gaussian_blur;
 use ocellus_image::resample::{ResampleMethod, Resampler};
 use ocellus_image::{Backend, Plane};
 use serde::{Deserialize, Serialize};
@@ -65,15 +66,6 @@ impl CenterPrior {
         }
         Ok(full)
     }
-}
-
-/// Separable Gaussian blur (clamped border, kernel cut at 3 sigma, normalized); sigma in
-/// pixels; sigma < 0.3 returns a copy.
-pub fn gaussian_blur(backend: Backend, map: &Plane<f32>, sigma: f32) -> Result<Plane<f32>> {
-    if !(sigma.is_finite() && sigma >= 0.0) {
-        return Err(EvalError::InvalidConfig(format!("blur sigma {sigma} must be finite and >= 0")));
-    }
-    Ok(ocellus_image::filter::gaussian_blur(backend, map, sigma)?)
 }
 
 /// A Gaussian of peak 1 centred on the image, sigma in pixels. The centre is

@@ -77,15 +77,7 @@ impl PreservingFilter {
 
     /// Filters `src` (which must be `width` x `height`) into `dst`.
     pub fn apply(&mut self, backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>) -> Result<()> {
-        if src.size() != (self.width, self.height) {
-            return Err(ImageError::SizeMismatch {
-                what: "map",
-                got_w: src.width(),
-                got_h: src.height(),
-                want_w: self.width,
-                want_h: self.height,
-            });
-        }
+        crate::check::same_size("map", src.size(), (self.width, self.height))?;
         dst.resize(self.width, self.height);
         preserving_kernel(backend, &self.k, self.sym, &self.fx, &self.rows, &mut self.padded, &mut self.tmp, src, dst);
         Ok(())
@@ -95,15 +87,7 @@ impl PreservingFilter {
 impl PreservingFilter {
     /// [`apply`](Self::apply) on eight interleaved maps at once (same result per lane).
     pub fn apply_lanes(&mut self, backend: Backend, src: &Plane<Lanes>, dst: &mut Plane<Lanes>) -> Result<()> {
-        if src.size() != (self.width, self.height) {
-            return Err(ImageError::SizeMismatch {
-                what: "maps",
-                got_w: src.width(),
-                got_h: src.height(),
-                want_w: self.width,
-                want_h: self.height,
-            });
-        }
+        crate::check::same_size("maps", src.size(), (self.width, self.height))?;
         dst.resize(self.width, self.height);
         preserving_lanes_kernel(
             backend,
