@@ -27,6 +27,10 @@ enum What {
     /// A camera looking down at a floor of real textures (brick, grass, gravel, mosaic) with
     /// known planar motion at 200 Hz: frames, TUM ground truth, wheel encoders (odometry).
     Ground(crate::generate_ground::GroundArgs),
+    /// A shaded coloured ball thrown, bouncing or approaching in 3D in front of a real photo,
+    /// through a known distorted camera, with occluders, a distractor, a lighting change and
+    /// noise: frames, truth.csv and camera.toml (try `ocellus track` on them).
+    Ball(crate::generate_ball::BallArgs),
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -83,6 +87,7 @@ pub fn run(a: GenerateArgs) -> Result<()> {
         What::Attention(a) => a,
         What::Chessboard(a) => return crate::generate_chessboard::run(a),
         What::Ground(a) => return crate::generate_ground::run(a),
+        What::Ball(a) => return crate::generate_ball::run(a),
     };
     let scenario = match a.scenario {
         ScenarioArg::Static => Scenario::Static,

@@ -15,6 +15,7 @@ mod demo;
 mod eval;
 mod frames;
 mod generate;
+mod generate_ball;
 mod generate_chessboard;
 mod generate_ground;
 mod inputs;
@@ -27,6 +28,7 @@ mod ranges;
 mod saliency_cmd;
 mod stereo_cmd;
 mod surprise_cmd;
+mod track_cmd;
 mod triangulate_cmd;
 mod undistort_cmd;
 
@@ -88,6 +90,10 @@ enum Command {
     /// the same command).
     #[command(visible_alias = "synth")]
     Generate(generate::GenerateArgs),
+    /// Where did it go: the 3D ball tracker (particle filter with a colour likelihood, boosted
+    /// by colour-blob detections) on frames; `track eval` scores a track against truth;
+    /// `track study` prints the accuracy figures on generated sequences.
+    Track(track_cmd::TrackArgs),
     /// Print benchmark figures (median ms per frame, fps on all cores, per stage, peak memory).
     Bench(bench::BenchArgs),
 }
@@ -123,6 +129,7 @@ fn main() {
         Command::Undistort(a) => undistort_cmd::run(a),
         Command::Odometry(a) => odometry_cmd::run(a),
         Command::Logpolar(a) => logpolar_cmd::run(a),
+        Command::Track(a) => track_cmd::run(a),
     };
     let r = r.and_then(|()| Ok(out::flush_stdout()?));
     if let Err(e) = r {

@@ -205,6 +205,28 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
             *p = d.state;
         });
         self.steps += 1;
+        self.weigh()
+    }
+
+    /// Multiplies the weights by `exp(log_increments)` without moving the particles (e.g. to
+    /// weigh a starting cloud by a first observation), normalizes, and resamples when the
+    /// ESS falls below the configured share; as a step's weight update.
+    pub fn reweight(&mut self, log_increments: &[f64]) -> Result<StepReport> {
+        if log_increments.len() != self.particles.len() {
+            return Err(EstimationError::InvalidInput(format!(
+                "{} weight increments for {} particles",
+                log_increments.len(),
+                self.particles.len()
+            )));
+        }
+        self.increments.clear();
+        self.increments.extend_from_slice(log_increments);
+        self.weigh()
+    }
+
+    /// Applies `self.increments` to the log weights, normalizes, resamples if due.
+    fn weigh(&mut self) -> Result<StepReport> {
+        let n = self.particles.len();
         if self.increments.iter().any(|v| v.is_nan()) {
             return Err(EstimationError::InvalidInput("the model gave a NaN log weight".into()));
         }

@@ -17,6 +17,7 @@
 pub mod center_prior;
 pub mod metrics;
 pub mod protocol;
+pub mod tracking;
 pub mod trajectory;
 pub mod tuning;
 

@@ -12,6 +12,7 @@
 //!   intrinsics, distortion and poses, with parameter standard deviations.
 //! - [`planar`]: planar robot poses (position and heading on the floor).
 //! - [`triangulate`]: points from two views (the seed's 4x3 least squares) and from N views (SVD).
+//! - [`sphere`]: a sphere's image circle through the lens, and ray-sphere intersection.
 //! - [`stereo`]: parallel stereo with explicit units (disparity, depth, pixel sizes).
 //! - [`block_matching`]: dense disparity by SAD block matching with uniqueness and
 //!   left-right checks; the bad-pixel rate against ground truth.
@@ -37,6 +38,7 @@ pub mod dlt;
 pub mod homography;
 pub mod planar;
 pub mod sgm;
+pub mod sphere;
 pub mod stereo;
 pub mod triangulate;
 mod wta;

@@ -3,6 +3,8 @@
 //! estimation) on frames rendered from real imagery by `ocellus-synth`, so that the CLI, the
 //! tests and the examples all run the same loop.
 //!
+//! - [`ball_tracking`]: generated ball worlds tracked by the plain and the boosted particle
+//!   filter, scored against the truth (SPEC 7).
 //! - [`corridor_experiment`]: the seed's corridor (SPEC 2.6): information-based view
 //!   planning switching from landmarks to a suddenly appearing person.
 //!
@@ -18,6 +20,7 @@
 //! # Ok::<(), SimError>(())
 //! ```
 
+pub mod ball_tracking;
 pub mod corridor_experiment;
 
 /// Errors of the simulations.
@@ -32,6 +35,12 @@ pub enum SimError {
     /// The scene generator failed.
     #[error(transparent)]
     Synth(#[from] ocellus_synth::SynthError),
+    /// The tracker failed.
+    #[error(transparent)]
+    Tracking(#[from] ocellus_tracking::TrackingError),
+    /// The evaluation failed.
+    #[error(transparent)]
+    Eval(#[from] ocellus_eval::EvalError),
     /// A parameter is out of range.
     #[error("invalid simulation parameter: {0}")]
     InvalidConfig(String),

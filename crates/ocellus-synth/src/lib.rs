@@ -2,6 +2,8 @@
 //!
 //! - [`attention_scenes`]: sequences for surprise, context and attention (a static scene with
 //!   sensor noise, an object that appears suddenly, a steady camera pan), with per-frame truth.
+//! - [`ball_world`]: a shaded coloured ball flying, bouncing, approaching in 3D in front of a
+//!   real photo, with occluders, a distractor, a lighting change and noise (tracking truth).
 //! - [`chessboard`]: views of a chessboard through a known distorted camera (calibration
 //!   ground truth).
 //! - [`ground`]: a camera looking down at a tiled real-texture floor with known planar motion
@@ -27,6 +29,7 @@
 //! ```
 
 pub mod attention_scenes;
+pub mod ball_world;
 pub mod chessboard;
 pub mod corridor;
 pub mod ground;

@@ -3,16 +3,18 @@
 //! a ball of known radius seen through a calibrated camera, lens distortion included.
 //!
 //! The particle filter's model ([`BallModel`], an `ocellus_estimation` [`Model`]): each
-//! particle moves with its velocity over `dt` plus white acceleration noise (the discrete
-//! white-noise acceleration model, Bar-Shalom et al. 2001, ch. 6), and is weighed by the
-//! colour likelihood of the ball's image circle in the frame.
+//! particle moves by [`MotionModel`] or, boosted, is drawn from a bottom-up detection
+//! (SPEC 7.4), and is weighed by the colour likelihood of the ball's image circle.
 
 use crate::colour::{BinnedFrame, Circle, ColourModel};
+use crate::detection::BallDetection;
+use crate::motion::{log_add, MotionModel};
 use crate::{Result, TrackingError};
 use nalgebra::Vector3;
 use ocellus_estimation::particle_filter::{Draw, Model};
 use ocellus_geometry::camera::PinholeCamera;
 use ocellus_geometry::distortion::Distortion;
+use ocellus_geometry::sphere::project_sphere;
 use ocellus_image::rng::SplitMix64;
 
 /// A ball hypothesis: centre and velocity in the world frame.
@@ -24,30 +26,36 @@ pub struct BallState {
     pub velocity: [f64; 3],
 }
 
-/// The image circle of a ball of `radius_m` centred at `centre` (world, metres): the centre's
-/// pixel and the radius `f R / sqrt(d^2 - R^2)` (the sphere's angular radius, d its distance
-/// from the camera), both through the lens distortion. `None` when the ball is not fully in
-/// front of the camera.
+/// The image circle of a ball of `radius_m` centred at `centre` (world, metres), through the
+/// lens distortion (`ocellus_geometry::sphere::project_sphere`). `None` when the ball is not
+/// fully in front of the camera.
 pub fn project_ball(
     camera: &PinholeCamera,
     distortion: &Distortion,
     centre: &Vector3<f64>,
     radius_m: f64,
 ) -> Option<Circle> {
-    let xc = camera.r * centre + camera.t;
-    let d2 = xc.norm_squared();
-    if !(xc.z > radius_m && d2 > radius_m * radius_m && radius_m > 0.0) {
-        return None;
-    }
-    let (px, _) = camera.project(centre).ok()?;
-    let r_px = camera.k.fx * radius_m / (d2 - radius_m * radius_m).sqrt();
-    let (cx, cy) = distortion.distort_pixel(&camera.k, px.x, px.y);
-    let (ex, ey) = distortion.distort_pixel(&camera.k, px.x + r_px, px.y);
-    let r = (ex - cx).hypot(ey - cy);
-    (cx.is_finite() && cy.is_finite() && r.is_finite()).then_some(Circle { x: cx, y: cy, r })
+    project_sphere(camera, distortion, centre, radius_m).map(|[x, y, r]| Circle { x, y, r })
 }
 
-/// The tracking model: motion, camera and colour likelihood.
+/// What one step of the tracker observes: the binned frame and the bottom-up detections
+/// (empty for the plain filter).
+#[derive(Clone, Debug, Default)]
+pub struct BallFrame {
+    /// The frame, binned once.
+    pub binned: BinnedFrame,
+    /// Colour-blob detections of the ball, 3D.
+    pub detections: Vec<BallDetection>,
+}
+
+/// The tracking model: motion, camera, colour likelihood and the boosted proposal.
+///
+/// The proposal is the mixture of Okuma et al. (ECCV 2004), drawn per particle:
+/// `q(x | x', z) = alpha q_det(x | z, x') + (1 - alpha) p(x | x')`. `q_det` puts the centre
+/// at one of the frame's detections (chosen uniformly, Gaussian about it, see
+/// [`BallDetection`]) and draws the velocity as a jump of the motion model does. The
+/// importance weight is corrected by `p(x | x') / q(x | x', z)` with both mixtures
+/// evaluated exactly; without detections, or with `boost = 0`, it is the bootstrap filter.
 #[derive(Clone, Debug)]
 pub struct BallModel {
     /// The calibrated camera (world to camera).
@@ -56,59 +64,73 @@ pub struct BallModel {
     pub distortion: Distortion,
     /// Ball radius, metres.
     pub radius_m: f64,
-    /// Time between frames, seconds.
-    pub dt_s: f64,
-    /// Standard deviation of the white acceleration noise per axis, m/s^2.
-    pub accel_sigma: f64,
-    /// Constant acceleration (e.g. gravity, [0, 9.81, 0] for y down), m/s^2.
-    pub gravity: [f64; 3],
+    /// The motion model p(x_t | x_t-1).
+    pub motion: MotionModel,
     /// The colour likelihood.
     pub colour: ColourModel,
+    /// Share `alpha` of the proposal drawn from the detections, in [0, 1].
+    pub boost: f64,
 }
 
 impl BallModel {
     /// Checks the parameters.
     pub fn validate(&self) -> Result<()> {
-        let ok = |v: f64| v.is_finite() && v > 0.0;
-        if !(ok(self.radius_m) && ok(self.dt_s) && self.accel_sigma.is_finite() && self.accel_sigma >= 0.0) {
+        if !(self.radius_m.is_finite() && self.radius_m > 0.0) {
+            return Err(TrackingError::Invalid(format!("ball radius {} m must be finite and positive", self.radius_m)));
+        }
+        if !(0.0..=1.0).contains(&self.boost) {
+            return Err(TrackingError::Invalid(format!("boost alpha {} is outside [0, 1]", self.boost)));
+        }
+        if !(self.colour.lambda.is_finite() && self.colour.lambda > 0.0) {
             return Err(TrackingError::Invalid(format!(
-                "ball radius {} m, frame interval {} s and acceleration noise {} m/s^2 must be finite (and positive)",
-                self.radius_m, self.dt_s, self.accel_sigma
+                "likelihood lambda {} must be finite and positive",
+                self.colour.lambda
             )));
         }
-        if !self.gravity.iter().all(|g| g.is_finite()) {
-            return Err(TrackingError::Invalid(format!("gravity {:?} is not finite", self.gravity)));
-        }
-        Ok(())
+        self.motion.validate()
     }
 
     /// The image circle of a state.
     pub fn circle(&self, s: &BallState) -> Option<Circle> {
         project_ball(&self.camera, &self.distortion, &Vector3::from(s.position), self.radius_m)
     }
+
+    /// `ln q_det(x | z, x')`: the detections' mixture for the centre, the jump's velocity.
+    fn log_detection_density(&self, prev: &BallState, s: &BallState, dets: &[BallDetection]) -> f64 {
+        let mut l = f64::NEG_INFINITY;
+        for d in dets {
+            l = log_add(l, d.log_density(&s.position));
+        }
+        l - (dets.len() as f64).ln() + self.motion.log_jump_velocity_density(prev, s)
+    }
 }
 
 impl Model for BallModel {
     type State = BallState;
-    type Observation = BinnedFrame;
+    type Observation = BallFrame;
 
-    /// Constant velocity with white acceleration noise a ~ N(0, sigma^2) per axis over the
-    /// interval: p += v dt + (g + a) dt^2 / 2, v += (g + a) dt. The proposal is the motion
-    /// model (the bootstrap filter), so the prior/proposal ratio is 1.
-    fn propose(&self, prev: &BallState, _: &BinnedFrame, rng: &mut SplitMix64) -> Draw<BallState> {
-        let dt = self.dt_s;
-        let mut s = *prev;
-        for k in 0..3 {
-            let a = self.gravity[k] + self.accel_sigma * rng.normal();
-            s.position[k] += prev.velocity[k] * dt + 0.5 * a * dt * dt;
-            s.velocity[k] += a * dt;
+    fn propose(&self, prev: &BallState, z: &BallFrame, rng: &mut SplitMix64) -> Draw<BallState> {
+        let dets = &z.detections;
+        if dets.is_empty() || self.boost == 0.0 {
+            return Draw { state: self.motion.sample(prev, rng), log_prior_over_proposal: 0.0 };
         }
-        Draw { state: s, log_prior_over_proposal: 0.0 }
+        let alpha = self.boost;
+        let state = if rng.unit() < alpha {
+            let d = &dets[rng.below(dets.len())];
+            BallState { position: d.sample_position(rng), velocity: self.motion.sample_jump_velocity(prev, rng) }
+        } else {
+            self.motion.sample(prev, rng)
+        };
+        let log_p = self.motion.log_density(prev, &state);
+        let log_q = log_add(alpha.ln() + self.log_detection_density(prev, &state, dets), (1.0 - alpha).ln() + log_p);
+        let ratio = log_p - log_q;
+        // Both are finite for a finite state; a state at infinity is impossible.
+        Draw { state, log_prior_over_proposal: if ratio.is_nan() { f64::NEG_INFINITY } else { ratio } }
     }
 
-    fn log_likelihood(&self, s: &BallState, frame: &BinnedFrame) -> f64 {
+    fn log_likelihood(&self, s: &BallState, frame: &BallFrame) -> f64 {
         match self.circle(s) {
-            Some(c) => self.colour.log_likelihood(frame, c),
+            Some(c) => self.colour.log_likelihood(&frame.binned, c),
             None => f64::NEG_INFINITY,
         }
     }

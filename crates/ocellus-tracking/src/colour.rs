@@ -231,8 +231,9 @@ impl ColourModel {
     }
 
     /// `BC(inner, model) - BC(inner, outer)` of `circle`, in [-1, 1]; -1 when no inner sample
-    /// falls on the frame or the circle is not finite with a positive radius. Samples off the
-    /// frame are left out (a ball half out of view is judged by its visible half).
+    /// falls on the frame or the circle is not finite with a positive radius. Inner samples
+    /// off the frame count as matching nothing (the inner histogram then sums to the share on
+    /// the frame); the outer histogram is over the ring's samples on the frame.
     pub fn score(&self, frame: &BinnedFrame, circle: Circle) -> f64 {
         let Circle { x, y, r } = circle;
         if !(x.is_finite() && y.is_finite() && r.is_finite() && r > 0.0) {
@@ -251,7 +252,10 @@ impl ColourModel {
         if n[0] == 0 {
             return -1.0;
         }
-        let (ni, no) = (n[0] as f64, n[1].max(1) as f64);
+        // The inner histogram is over all the disc's samples: those off the frame are
+        // evidence missing, not evidence of the model, so a disc half out of view scores at
+        // most sqrt(1/2) on its match (a light at the frame's edge must not beat the ball).
+        let (ni, no) = (self.inner.len() as f64, n[1].max(1) as f64);
         let mut bc_model = 0.0;
         let mut bc_outer = 0.0;
         for b in 0..BINS {

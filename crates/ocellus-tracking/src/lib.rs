@@ -5,8 +5,14 @@
 //! - [`colour`]: HSV colour histograms (Pérez et al. 2002), a frame binned once, and the
 //!   seed's likelihood `BC(inner, model) - BC(inner, outer)` of an image circle from sample
 //!   points on the disc and on a ring just outside it (SPEC 7.2);
-//! - [`ball`]: the 3D ball (position and velocity, constant velocity with gravity) projected
-//!   through a calibrated camera with distortion, as a particle-filter model (SPEC 7.3).
+//! - [`motion`]: constant velocity with gravity and white acceleration noise, plus rare jumps
+//!   (SPEC 7.3);
+//! - [`detection`]: colour-segmentation blobs as 3D ball hypotheses, depth from the blob size
+//!   and the known radius (SPEC 7.4);
+//! - [`ball`]: the 3D ball projected through a calibrated camera with distortion, as a
+//!   particle-filter model with the boosted proposal of Okuma et al. 2004 (SPEC 7.3, 7.4);
+//! - [`tracker`]: the tracker over a frame sequence (start from a detection, step, estimate,
+//!   lost or not).
 //!
 //! Image conventions are `ocellus-image`'s: x right, y down, pixel centres at integers.
 //!
@@ -28,6 +34,9 @@
 
 pub mod ball;
 pub mod colour;
+pub mod detection;
+pub mod motion;
+pub mod tracker;
 
 /// Errors of the tracking crate.
 #[derive(Debug, thiserror::Error)]
@@ -35,6 +44,9 @@ pub enum TrackingError {
     /// An image operation failed (the cause, for matching).
     #[error(transparent)]
     Image(#[from] ocellus_image::ImageError),
+    /// The particle filter refused (the cause, for matching).
+    #[error(transparent)]
+    Estimation(#[from] ocellus_estimation::EstimationError),
     /// A parameter or an input is unusable.
     #[error("invalid tracking input: {0}")]
     Invalid(String),

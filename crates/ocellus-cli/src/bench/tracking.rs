@@ -12,8 +12,9 @@ use ocellus_geometry::camera::{Intrinsics, PinholeCamera};
 use ocellus_geometry::distortion::Distortion;
 use ocellus_image::rng::SplitMix64;
 use ocellus_image::Plane;
-use ocellus_tracking::ball::{project_ball, BallModel, BallState};
+use ocellus_tracking::ball::{project_ball, BallFrame, BallModel, BallState};
 use ocellus_tracking::colour::{BinnedFrame, Circle, ColourModel};
+use ocellus_tracking::motion::MotionModel;
 use serde_json::json;
 use std::time::Instant;
 
@@ -34,8 +35,7 @@ fn scene() -> Result<(Plane<[u8; 3]>, BallModel, Vector3<f64>)> {
         }
     });
     let colour = ColourModel::from_patch(&frame, Circle { r: 0.8 * c.r, ..c })?;
-    let model =
-        BallModel { camera, distortion, radius_m: 0.05, dt_s: 1.0 / 30.0, accel_sigma: 3.0, gravity: [0.0; 3], colour };
+    let model = BallModel { camera, distortion, radius_m: 0.05, motion: MotionModel::at_fps(30.0), colour, boost: 0.0 };
     Ok((frame, model, ball))
 }
 
@@ -58,13 +58,13 @@ fn sir_step_ms(
             .collect();
         let cfg = FilterConfig { resample_below: 1.0, ..FilterConfig::default() };
         let mut pf = ParticleFilter::new(cfg, particles)?;
-        let mut binned = BinnedFrame::default();
+        let mut obs = BallFrame::default();
         let reps = (200_000 / n).clamp(5, 200);
         let mut t = Vec::with_capacity(reps);
         for _ in 0..reps {
             let s = Instant::now();
-            binned.update(frame);
-            pf.step(model, &binned)?;
+            obs.binned.update(frame);
+            pf.step(model, &obs)?;
             t.push(s.elapsed().as_secs_f64() * 1e3);
         }
         Ok(median(&mut t))

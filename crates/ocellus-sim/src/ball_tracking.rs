@@ -1,0 +1,120 @@
+//! The tracking experiment (SPEC 7): generated ball worlds tracked by the plain SIR filter and
+//! by the boosted filter, scored against the truth. `ocellus track study`, the tests and the
+//! README's figures run this one loop.
+//!
+//! Each run: a [`BallWorld`] of one trajectory and seed with both occluders (a pillar hiding
+//! up to half the ball, a panel hiding it for 10 frames) and sensor noise; the colour model
+//! is taken from the first frame (a disc of 0.8 of the ball's true image radius, as a user
+//! would click a patch); the tracker knows the camera, the ball's radius and, for the thrown
+//! and bouncing balls, gravity.
+
+use crate::Result;
+use ocellus_eval::tracking::{score, EstimateFrame, TrackingScores, TruthFrame};
+use ocellus_image::Plane;
+use ocellus_synth::ball_world::{BallTruth, BallWorld, BallWorldConfig, Occlusion, Trajectory, GRAVITY};
+use ocellus_tracking::colour::{Circle, ColourModel};
+use ocellus_tracking::tracker::{BallTracker, TrackEstimate, TrackerConfig};
+
+/// One tracked sequence.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct StudyRun {
+    /// The motion of the ball.
+    pub trajectory: Trajectory,
+    /// The world's seed (the filter's is the same).
+    pub seed: u64,
+    /// The proposal's boost alpha (0: plain SIR).
+    pub boost: f64,
+    /// The figures.
+    pub scores: TrackingScores,
+}
+
+/// The colour model from the first frame: a disc of 0.8 of the ball's image radius.
+pub fn model_from_first_frame(frame: &Plane<[u8; 3]>, truth: &BallTruth) -> Result<ColourModel> {
+    let [x, y, r] = truth
+        .circle
+        .ok_or_else(|| crate::SimError::InvalidConfig("the ball is not in view in the first frame".into()))?;
+    Ok(ColourModel::from_patch(frame, Circle { x, y, r: 0.8 * r })?)
+}
+
+/// The tracker's configuration for a world: `base` with the world's frame rate and, for
+/// ballistic trajectories, gravity.
+pub fn tracker_config(world: &BallWorldConfig, base: TrackerConfig) -> TrackerConfig {
+    let mut cfg = base;
+    cfg.motion.dt_s = 1.0 / world.fps;
+    cfg.motion.gravity = match world.trajectory {
+        Trajectory::Throw | Trajectory::Bounce => [0.0, GRAVITY, 0.0],
+        Trajectory::Approach => [0.0; 3],
+    };
+    cfg
+}
+
+/// The estimate as the evaluation reads it.
+pub fn estimate_frame(e: &TrackEstimate) -> EstimateFrame {
+    EstimateFrame { position: e.position, centre_px: e.circle.map(|c| [c.x, c.y]), lost: e.lost }
+}
+
+/// The truth as the evaluation reads it.
+pub fn truth_frame(t: &BallTruth) -> TruthFrame {
+    TruthFrame { position: t.position, circle: t.circle, visible_fraction: t.visible_fraction }
+}
+
+/// Tracks every frame of `world` with `cfg` (gravity and frame rate as given); `each` sees
+/// every frame with its truth and estimate (for overlays).
+pub fn track_world(
+    world: &BallWorld,
+    cfg: TrackerConfig,
+    mut each: impl FnMut(&Plane<[u8; 3]>, &BallTruth, &TrackEstimate, &BallTracker) -> Result<()>,
+) -> Result<(Vec<BallTruth>, Vec<TrackEstimate>)> {
+    let (f0, t0) = world.frame(0)?;
+    let colour = model_from_first_frame(&f0, &t0)?;
+    let cam = *world.camera();
+    let mut tracker = BallTracker::new(cfg, cam, world.config().distortion, world.config().radius_m, colour)?;
+    let (mut truths, mut estimates) = (Vec::with_capacity(world.len()), Vec::with_capacity(world.len()));
+    for k in 0..world.len() {
+        let (f, t) = if k == 0 { (f0.clone(), t0) } else { world.frame(k)? };
+        let e = tracker.process(&f)?;
+        each(&f, &t, &e, &tracker)?;
+        truths.push(t);
+        estimates.push(e);
+    }
+    Ok((truths, estimates))
+}
+
+/// Scores a tracked sequence.
+pub fn score_run(truths: &[BallTruth], estimates: &[TrackEstimate]) -> Result<TrackingScores> {
+    let t: Vec<TruthFrame> = truths.iter().map(truth_frame).collect();
+    let e: Vec<EstimateFrame> = estimates.iter().map(estimate_frame).collect();
+    Ok(score(&t, &e)?)
+}
+
+/// The world of the study for a trajectory and seed: both occluders, noise sigma 3.
+pub fn study_world_config(trajectory: Trajectory, seed: u64) -> BallWorldConfig {
+    BallWorldConfig { occlusion: Occlusion::Both, ..BallWorldConfig::new(trajectory, seed) }
+}
+
+/// Runs every trajectory x seed with each boost in `boosts` (0 is the plain SIR), the
+/// tracker otherwise `base`.
+pub fn study(
+    background: &Plane<[f32; 3]>,
+    occluder: &Plane<[f32; 3]>,
+    trajectories: &[Trajectory],
+    seeds: &[u64],
+    boosts: &[f64],
+    base: TrackerConfig,
+) -> Result<Vec<StudyRun>> {
+    let mut runs = Vec::new();
+    for &trajectory in trajectories {
+        for &seed in seeds {
+            let wc = study_world_config(trajectory, seed);
+            let world = BallWorld::new(wc, background, occluder)?;
+            for &boost in boosts {
+                let mut cfg = tracker_config(&wc, base);
+                cfg.boost = boost;
+                cfg.filter.seed = seed;
+                let (t, e) = track_world(&world, cfg, |_, _, _, _| Ok(()))?;
+                runs.push(StudyRun { trajectory, seed, boost, scores: score_run(&t, &e)? });
+            }
+        }
+    }
+    Ok(runs)
+}

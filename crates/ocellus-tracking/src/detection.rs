@@ -1,0 +1,368 @@
+//! Bottom-up ball detections (SPEC 7.4): colour segmentation blobs of a binned frame, each
+//! turned into a 3D hypothesis of the ball's centre, the depth from the blob's size and the
+//! known ball radius. They feed the boosted proposal of [`crate::ball::BallModel`].
+//!
+//! A pixel belongs to the ball's colour when its bin holds at least
+//! [`DetectorConfig::min_bin_share`] of the model histogram; blobs are the 4-connected
+//! components of those pixels (union-find over one pass). A blob's radius is that of the disc
+//! of the same area, or half its longer side when the blob looks cut (a ball half hidden
+//! keeps its full extent in one direction); its centre is the centroid.
+//!
+//! The distance of the centre from the camera follows from the image radius r (pixels) of a
+//! sphere of radius R at distance d seen with focal f: `r = f R / sqrt(d^2 - R^2)`, so
+//! `d = R sqrt(1 + f^2 / r^2)`.
+
+use crate::colour::{BinnedFrame, Circle, ColourModel, Histogram, BINS};
+use crate::{Result, TrackingError};
+use nalgebra::{Vector2, Vector3};
+use ocellus_geometry::camera::PinholeCamera;
+use ocellus_geometry::distortion::Distortion;
+use ocellus_image::rng::SplitMix64;
+
+/// `ln(2 pi)`.
+const LN_2PI: f64 = 1.837_877_066_409_345_5;
+
+/// Parameters of the colour-blob detector.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DetectorConfig {
+    /// A bin is the ball's colour when it holds at least this share of the model histogram,
+    /// in (0, 1].
+    pub min_bin_share: f64,
+    /// Smallest blob kept, pixels.
+    pub min_area_px: usize,
+    /// Largest number of blobs kept (the largest ones).
+    pub max_detections: usize,
+    /// Smallest area over the area of the disc of the blob's radius: blobs less round are
+    /// not balls, in (0, 1].
+    pub min_fill: f64,
+    /// Smallest colour score `BC(inner, model) - BC(inner, outer)` of a blob's circle: a
+    /// patch of the ball's colour that does not stand out from its surroundings is no ball,
+    /// in [-1, 1].
+    pub min_score: f64,
+    /// Spread of a detection's centre across the line of sight, as a share of its image
+    /// radius (at least one pixel).
+    pub lateral_sigma_radii: f64,
+    /// Spread of a detection's distance, as a share of the distance.
+    pub depth_sigma_frac: f64,
+}
+
+impl Default for DetectorConfig {
+    fn default() -> Self {
+        Self {
+            min_bin_share: 0.04,
+            min_area_px: 12,
+            max_detections: 8,
+            min_fill: 0.35,
+            min_score: 0.3,
+            lateral_sigma_radii: 0.15,
+            depth_sigma_frac: 0.12,
+        }
+    }
+}
+
+impl DetectorConfig {
+    /// Checks the parameters.
+    pub fn validate(&self) -> Result<()> {
+        let unit = |v: f64| v.is_finite() && v > 0.0 && v <= 1.0;
+        if !(unit(self.min_bin_share) && unit(self.min_fill)) {
+            return Err(TrackingError::Invalid(format!(
+                "detector min_bin_share {} and min_fill {} must be in (0, 1]",
+                self.min_bin_share, self.min_fill
+            )));
+        }
+        for (name, v) in
+            [("lateral_sigma_radii", self.lateral_sigma_radii), ("depth_sigma_frac", self.depth_sigma_frac)]
+        {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(TrackingError::Invalid(format!("detector {name} = {v} must be finite and positive")));
+            }
+        }
+        if !(self.min_score.is_finite() && (-1.0..=1.0).contains(&self.min_score)) {
+            return Err(TrackingError::Invalid(format!("detector min_score {} is outside [-1, 1]", self.min_score)));
+        }
+        if self.min_area_px == 0 {
+            return Err(TrackingError::Invalid("detector min_area_px must be at least 1".into()));
+        }
+        Ok(())
+    }
+}
+
+/// A connected region of the ball's colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Blob {
+    /// Pixels in the blob.
+    pub area_px: usize,
+    /// Centroid (x, y), pixels.
+    pub centroid: [f64; 2],
+    /// Bounding box `[x0, y0, x1, y1]`, inclusive pixel indices.
+    pub bbox: [usize; 4],
+}
+
+impl Blob {
+    /// The blob as an image circle (see the module doc for the radius).
+    pub fn circle(&self) -> Circle {
+        let r_area = (self.area_px as f64 / std::f64::consts::PI).sqrt();
+        let extent = (self.bbox[2] - self.bbox[0] + 1).max(self.bbox[3] - self.bbox[1] + 1) as f64;
+        let r_extent = extent / 2.0;
+        let r = if r_extent > 1.15 * r_area { r_extent } else { r_area };
+        Circle { x: self.centroid[0], y: self.centroid[1], r }
+    }
+}
+
+/// The blobs of `frame` whose bins hold at least `min_bin_share` of `model`, largest first,
+/// at most `max_detections`, each at least `min_area_px` and round enough (`min_fill`).
+pub fn blobs(frame: &BinnedFrame, model: &Histogram, cfg: &DetectorConfig) -> Vec<Blob> {
+    let member: [bool; BINS] = std::array::from_fn(|b| model.0[b] >= cfg.min_bin_share);
+    let bins = frame.bins();
+    let (w, h) = bins.size();
+    // Union-find over provisional labels, 4-connectivity: one pass labels and merges.
+    let mut label = vec![u32::MAX; w * h];
+    let mut parent: Vec<u32> = Vec::new();
+    fn find(parent: &mut [u32], mut a: u32) -> u32 {
+        while parent[a as usize] != a {
+            parent[a as usize] = parent[parent[a as usize] as usize];
+            a = parent[a as usize];
+        }
+        a
+    }
+    for y in 0..h {
+        let row = bins.row(y);
+        for x in 0..w {
+            if !member[row[x] as usize] {
+                continue;
+            }
+            let left = if x > 0 { label[y * w + x - 1] } else { u32::MAX };
+            let up = if y > 0 { label[(y - 1) * w + x] } else { u32::MAX };
+            let l = match (left != u32::MAX, up != u32::MAX) {
+                (false, false) => {
+                    parent.push(parent.len() as u32);
+                    parent.len() as u32 - 1
+                }
+                (true, false) => left,
+                (false, true) => up,
+                (true, true) => {
+                    let (a, b) = (find(&mut parent, left), find(&mut parent, up));
+                    let (lo, hi) = (a.min(b), a.max(b));
+                    parent[hi as usize] = lo;
+                    lo
+                }
+            };
+            label[y * w + x] = l;
+        }
+    }
+    // Statistics per root: area, sums for the centroid, bounding box.
+    let roots: Vec<u32> = (0..parent.len() as u32).map(|l| find(&mut parent, l)).collect();
+    let mut stats = vec![(0usize, 0.0f64, 0.0f64, [usize::MAX, usize::MAX, 0usize, 0usize]); parent.len()];
+    for y in 0..h {
+        for x in 0..w {
+            let l = label[y * w + x];
+            if l == u32::MAX {
+                continue;
+            }
+            let s = &mut stats[roots[l as usize] as usize];
+            s.0 += 1;
+            s.1 += x as f64;
+            s.2 += y as f64;
+            s.3 = [s.3[0].min(x), s.3[1].min(y), s.3[2].max(x), s.3[3].max(y)];
+        }
+    }
+    let mut out: Vec<Blob> = stats
+        .into_iter()
+        .filter(|s| s.0 >= cfg.min_area_px)
+        .map(|(n, sx, sy, bbox)| Blob { area_px: n, centroid: [sx / n as f64, sy / n as f64], bbox })
+        .filter(|b| {
+            let r = b.circle().r;
+            b.area_px as f64 >= cfg.min_fill * std::f64::consts::PI * r * r
+        })
+        .collect();
+    out.sort_by(|a, b| b.area_px.cmp(&a.area_px).then(a.bbox.cmp(&b.bbox)));
+    out.truncate(cfg.max_detections);
+    out
+}
+
+/// A 3D hypothesis of the ball's centre from a blob, with the spread of the proposal drawn
+/// about it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BallDetection {
+    /// The blob's image circle, pixels.
+    pub circle: Circle,
+    /// The ball's centre, metres, world frame.
+    pub position: [f64; 3],
+    /// Unit line of sight through the centre, world frame.
+    pub direction: [f64; 3],
+    /// Standard deviation across the line of sight, metres.
+    pub sigma_lateral_m: f64,
+    /// Standard deviation along the line of sight, metres.
+    pub sigma_depth_m: f64,
+}
+
+/// Two unit vectors orthogonal to `u` and to each other.
+fn basis(u: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
+    let a = if u.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+    let e1 = u.cross(&a).normalize();
+    (e1, u.cross(&e1))
+}
+
+impl BallDetection {
+    /// The hypothesis of `blob` for a ball of `radius_m` seen by `camera` with `distortion`;
+    /// `None` when the blob's centre cannot be undistorted.
+    pub fn from_blob(
+        blob: &Blob,
+        camera: &PinholeCamera,
+        distortion: &Distortion,
+        radius_m: f64,
+        cfg: &DetectorConfig,
+    ) -> Option<Self> {
+        let circle = blob.circle();
+        let (ux, uy) = distortion.undistort_pixel(&camera.k, circle.x, circle.y).ok()?;
+        let (centre, dir) = camera.back_project(&Vector2::new(ux, uy));
+        let f = 0.5 * (camera.k.fx + camera.k.fy);
+        let d = radius_m * (1.0 + (f / circle.r).powi(2)).sqrt();
+        let p = centre + d * dir;
+        let sigma_lateral_m = (cfg.lateral_sigma_radii * circle.r).max(1.0) * d / f;
+        let ok = p.iter().all(|v| v.is_finite()) && sigma_lateral_m.is_finite();
+        ok.then_some(Self {
+            circle,
+            position: p.into(),
+            direction: dir.into(),
+            sigma_lateral_m,
+            sigma_depth_m: cfg.depth_sigma_frac * d,
+        })
+    }
+
+    /// Draws a centre from the detection's Gaussian.
+    pub fn sample_position(&self, rng: &mut SplitMix64) -> [f64; 3] {
+        let u = Vector3::from(self.direction);
+        let (e1, e2) = basis(&u);
+        let p = Vector3::from(self.position)
+            + self.sigma_lateral_m * (rng.normal() * e1 + rng.normal() * e2)
+            + self.sigma_depth_m * rng.normal() * u;
+        p.into()
+    }
+
+    /// `ln` of the detection's Gaussian density at `position`.
+    pub fn log_density(&self, position: &[f64; 3]) -> f64 {
+        let u = Vector3::from(self.direction);
+        let d = Vector3::from(*position) - Vector3::from(self.position);
+        let along = d.dot(&u);
+        let across2 = (d - along * u).norm_squared();
+        let (sl, sd) = (self.sigma_lateral_m, self.sigma_depth_m);
+        -1.5 * LN_2PI - 2.0 * sl.ln() - sd.ln() - 0.5 * (across2 / (sl * sl) + along * along / (sd * sd))
+    }
+}
+
+/// The 3D hypotheses of the blobs of the ball's colour in `frame` whose circles score at
+/// least `min_score` under `colour`, best score first.
+pub fn detect_balls(
+    frame: &BinnedFrame,
+    colour: &ColourModel,
+    camera: &PinholeCamera,
+    distortion: &Distortion,
+    radius_m: f64,
+    cfg: &DetectorConfig,
+) -> Vec<BallDetection> {
+    let mut scored: Vec<(f64, BallDetection)> = blobs(frame, colour.histogram(), cfg)
+        .iter()
+        .filter_map(|b| BallDetection::from_blob(b, camera, distortion, radius_m, cfg))
+        .map(|d| (colour.score(frame, d.circle), d))
+        .filter(|(s, _)| *s >= cfg.min_score)
+        .collect();
+    scored.sort_by(|a, b| b.0.total_cmp(&a.0));
+    scored.into_iter().map(|(_, d)| d).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ball::project_ball;
+    use nalgebra::Matrix3;
+    use ocellus_geometry::camera::Intrinsics;
+    use ocellus_image::Plane;
+
+    fn camera() -> PinholeCamera {
+        let k = Intrinsics { fx: 600.0, fy: 600.0, cx: 319.5, cy: 239.5, skew: 0.0 };
+        PinholeCamera { k, r: Matrix3::identity(), t: Vector3::zeros() }
+    }
+
+    /// A real photo with an orange ball at `centre`, and optionally a second orange disc.
+    fn frame(c: Circle, other: Option<Circle>, hide_left: bool) -> Plane<[u8; 3]> {
+        let photo = ocellus_io::read_image(ocellus_testdata::data_file("astronaut.png")).unwrap().to_u8();
+        Plane::from_fn(640, 480, |x, y| {
+            let inside = |c: &Circle| (x as f64 - c.x).powi(2) + (y as f64 - c.y).powi(2) <= c.r * c.r;
+            if (inside(&c) && !(hide_left && (x as f64) < c.x)) || other.as_ref().is_some_and(inside) {
+                [240, 118, 22]
+            } else {
+                photo.get(x * 512 / 640, y * 512 / 480)
+            }
+        })
+    }
+
+    #[test]
+    fn a_blob_gives_the_ball_in_3d() {
+        let cam = camera();
+        let d = Distortion::default();
+        let truth = Vector3::new(0.3, -0.1, 2.2);
+        let c = project_ball(&cam, &d, &truth, 0.05).unwrap();
+        let f = frame(c, Some(Circle { x: 120.0, y: 110.0, r: 30.0 }), false);
+        let binned = BinnedFrame::new(&f);
+        let model = crate::colour::ColourModel::from_colour([240, 118, 22]);
+        let cfg = DetectorConfig::default();
+        let found = detect_balls(&binned, &model, &cam, &d, 0.05, &cfg);
+        assert_eq!(found.len(), 2, "{found:?}");
+        // The photo's own orange patches do not stand out from their surroundings (scores
+        // below 0.1); the larger disc scores best: a nearer ball (30 px: about 1 m away).
+        let dist = Vector3::from(found[0].position).norm();
+        assert!((dist - 0.05 * (1.0f64 + 400.0).sqrt()).abs() < 0.01, "{:?}", found[0]);
+        let ball = found[1];
+        let err = (Vector3::from(ball.position) - truth).norm();
+        // Radius 13.6 px: half a pixel of radius is 3.7 % of the depth.
+        assert!(err < 0.04 * truth.z, "{ball:?} vs {truth}");
+        assert!((ball.circle.x - c.x).abs() < 0.5 && (ball.circle.y - c.y).abs() < 0.5);
+    }
+
+    #[test]
+    fn half_hidden_keeps_the_extent() {
+        let c = Circle { x: 300.0, y: 200.0, r: 20.0 };
+        let f = frame(c, None, true);
+        let model = crate::colour::ColourModel::from_colour([240, 118, 22]);
+        let b = blobs(&BinnedFrame::new(&f), model.histogram(), &DetectorConfig::default());
+        // The photo has orange patches too: take the blob at the half disc.
+        let got =
+            b.iter().map(Blob::circle).find(|c| (c.x - 300.0).abs() < 20.0 && (c.y - 200.0).abs() < 20.0).unwrap();
+        assert!((got.r - 20.0).abs() < 1.0, "{got:?}");
+        // The centroid of a half disc lies 4r / 3 pi right of the centre.
+        assert!((got.x - (300.0 + 80.0 / (3.0 * std::f64::consts::PI))).abs() < 1.0, "{got:?}");
+    }
+
+    #[test]
+    fn the_proposal_density_matches_its_samples() {
+        let det = BallDetection {
+            circle: Circle { x: 0.0, y: 0.0, r: 10.0 },
+            position: [0.2, 0.1, 2.0],
+            direction: Vector3::new(0.1, 0.05, 1.0).normalize().into(),
+            sigma_lateral_m: 0.01,
+            sigma_depth_m: 0.2,
+        };
+        let mut rng = SplitMix64::new(9);
+        // E[-ln q] over samples is the Gaussian's entropy: 1.5 (1 + ln 2 pi) + ln(sl^2 sd).
+        let n = 50_000;
+        let h: f64 = (0..n).map(|_| -det.log_density(&det.sample_position(&mut rng))).sum::<f64>() / n as f64;
+        let want = 1.5 * (1.0 + LN_2PI) + (0.01f64 * 0.01 * 0.2).ln();
+        assert!((h - want).abs() < 0.02, "{h} vs {want}");
+    }
+
+    #[test]
+    fn unusable_detector_settings_are_refused() {
+        let ok = DetectorConfig::default();
+        assert!(ok.validate().is_ok());
+        for c in [
+            DetectorConfig { min_bin_share: 0.0, ..ok },
+            DetectorConfig { min_fill: f64::NAN, ..ok },
+            DetectorConfig { depth_sigma_frac: -0.1, ..ok },
+            DetectorConfig { min_area_px: 0, ..ok },
+        ] {
+            assert!(c.validate().is_err(), "{c:?}");
+        }
+    }
+}

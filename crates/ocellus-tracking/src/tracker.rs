@@ -1,0 +1,233 @@
+//! The 3D ball tracker (SPEC 7.3, 7.4): a particle filter over [`BallState`] with the colour
+//! likelihood, started from the first colour-blob detection, boosted by the detections of
+//! every frame (`boost > 0`) or plain SIR/SIS (`boost = 0`).
+//!
+//! ```no_run
+//! # fn frames() -> Vec<ocellus_image::Plane<[u8; 3]>> { Vec::new() }
+//! use ocellus_geometry::camera::{Intrinsics, PinholeCamera};
+//! use ocellus_tracking::colour::ColourModel;
+//! use ocellus_tracking::tracker::{BallTracker, TrackerConfig};
+//! let k = Intrinsics { fx: 600.0, fy: 600.0, cx: 319.5, cy: 239.5, skew: 0.0 };
+//! let camera = PinholeCamera { k, r: nalgebra::Matrix3::identity(), t: nalgebra::Vector3::zeros() };
+//! let colour = ColourModel::from_colour([245, 120, 25]);
+//! let cfg = TrackerConfig::at_fps(30.0);
+//! let mut tracker = BallTracker::new(cfg, camera, Default::default(), 0.05, colour)?;
+//! for f in frames() {
+//!     let e = tracker.process(&f)?;
+//!     println!("{:?} lost {}", e.position, e.lost);
+//! }
+//! # Ok::<(), ocellus_tracking::TrackingError>(())
+//! ```
+
+use crate::ball::{BallFrame, BallModel, BallState};
+use crate::colour::{Circle, ColourModel};
+use crate::detection::{detect_balls, BallDetection, DetectorConfig};
+use crate::motion::MotionModel;
+use crate::{Result, TrackingError};
+use ocellus_estimation::particle_filter::{FilterConfig, ParticleFilter};
+use ocellus_geometry::camera::PinholeCamera;
+use ocellus_geometry::distortion::Distortion;
+use ocellus_image::rng::SplitMix64;
+use ocellus_image::Plane;
+
+/// Largest number of particles a tracker takes (about 100 MB of state).
+pub const MAX_PARTICLES: usize = 2_000_000;
+
+/// Parameters of a [`BallTracker`].
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackerConfig {
+    /// Number of particles, 1..=[`MAX_PARTICLES`].
+    pub particles: usize,
+    /// Share alpha of the proposal drawn from detections, in [0, 1] (0: the plain filter).
+    pub boost: f64,
+    /// Resampling threshold, scheme and seed.
+    pub filter: FilterConfig,
+    /// The motion model.
+    pub motion: MotionModel,
+    /// The colour-blob detector.
+    pub detector: DetectorConfig,
+    /// `lambda` of the colour likelihood `exp(lambda * score)`.
+    pub lambda: f64,
+    /// The estimate is reported lost when the colour score of its circle is below this.
+    pub lost_score: f64,
+}
+
+impl TrackerConfig {
+    /// Defaults for frames at `fps`: 4000 particles, boost 0.2, resampling below ESS N/2,
+    /// lambda 20, lost below score 0.2.
+    pub fn at_fps(fps: f64) -> Self {
+        Self {
+            particles: 4000,
+            boost: 0.2,
+            filter: FilterConfig::default(),
+            motion: MotionModel::at_fps(fps),
+            detector: DetectorConfig::default(),
+            lambda: crate::colour::DEFAULT_LAMBDA,
+            lost_score: 0.2,
+        }
+    }
+
+    /// Checks the parameters.
+    pub fn validate(&self) -> Result<()> {
+        if !(1..=MAX_PARTICLES).contains(&self.particles) {
+            return Err(TrackingError::Invalid(format!(
+                "{} particles: a tracker needs 1..={MAX_PARTICLES}",
+                self.particles
+            )));
+        }
+        if !(self.lost_score.is_finite() && (-1.0..=1.0).contains(&self.lost_score)) {
+            return Err(TrackingError::Invalid(format!("lost_score {} is outside [-1, 1]", self.lost_score)));
+        }
+        if !(0.0..=1.0).contains(&self.filter.resample_below) {
+            return Err(TrackingError::Invalid(format!(
+                "resample_below {} is outside [0, 1]",
+                self.filter.resample_below
+            )));
+        }
+        self.detector.validate()?;
+        self.motion.validate()
+    }
+}
+
+/// What the tracker says about one frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrackEstimate {
+    /// Frame index from 0.
+    pub frame: usize,
+    /// The weighted mean centre, metres (`None` before the first detection).
+    pub position: Option<[f64; 3]>,
+    /// The weighted mean velocity, m/s.
+    pub velocity: Option<[f64; 3]>,
+    /// The image circle of the mean centre.
+    pub circle: Option<Circle>,
+    /// Effective sample size after the weight update, particles (0 before the start).
+    pub ess: f64,
+    /// Colour score of the estimate's circle, in [-1, 1].
+    pub score: f64,
+    /// Whether the estimate is lost (not started, or the score below `lost_score`).
+    pub lost: bool,
+    /// Number of detections in this frame.
+    pub detections: usize,
+}
+
+/// A ball tracker over a frame sequence.
+pub struct BallTracker {
+    cfg: TrackerConfig,
+    model: BallModel,
+    filter: Option<ParticleFilter<BallState>>,
+    obs: BallFrame,
+    frame: usize,
+}
+
+impl BallTracker {
+    /// A tracker for a ball of `radius_m` of colour `colour`, seen by `camera`.
+    pub fn new(
+        cfg: TrackerConfig,
+        camera: PinholeCamera,
+        distortion: Distortion,
+        radius_m: f64,
+        mut colour: ColourModel,
+    ) -> Result<Self> {
+        cfg.validate()?;
+        let grey: f64 = colour.histogram().0[crate::colour::HUE_BINS * crate::colour::SATURATION_BINS..].iter().sum();
+        if grey > 0.5 {
+            return Err(TrackingError::Invalid(format!(
+                "{:.0} % of the colour model is grey, black or white (no reliable hue): pick a patch on the coloured ball",
+                100.0 * grey
+            )));
+        }
+        colour.lambda = cfg.lambda;
+        let model = BallModel { camera, distortion, radius_m, motion: cfg.motion, colour, boost: cfg.boost };
+        model.validate()?;
+        Ok(Self { cfg, model, filter: None, obs: BallFrame::default(), frame: 0 })
+    }
+
+    /// The model (camera, motion, colour).
+    pub fn model(&self) -> &BallModel {
+        &self.model
+    }
+
+    /// The particles (empty before the first detection).
+    pub fn particles(&self) -> &[BallState] {
+        self.filter.as_ref().map_or(&[], |f| f.particles())
+    }
+
+    /// This frame's detections.
+    pub fn detections(&self) -> &[BallDetection] {
+        &self.obs.detections
+    }
+
+    /// The detection to start from: the best colour score of its circle.
+    fn best_detection(&self) -> Option<BallDetection> {
+        let score = |d: &BallDetection| self.model.colour.score(&self.obs.binned, d.circle);
+        self.obs.detections.iter().copied().max_by(|a, b| score(a).total_cmp(&score(b)))
+    }
+
+    /// Takes one frame: bins it, detects blobs, then starts the filter from the best
+    /// detection or steps it.
+    pub fn process(&mut self, frame: &Plane<[u8; 3]>) -> Result<TrackEstimate> {
+        let k = self.frame;
+        self.frame += 1;
+        self.obs.binned.update(frame);
+        let m = &self.model;
+        self.obs.detections =
+            detect_balls(&self.obs.binned, &m.colour, &m.camera, &m.distortion, m.radius_m, &self.cfg.detector);
+        let n_det = self.obs.detections.len();
+        let ess = match &mut self.filter {
+            Some(f) => f.step(&self.model, &self.obs)?.ess,
+            None => match self.best_detection() {
+                Some(d) => {
+                    let mut rng = SplitMix64::new(self.cfg.filter.seed ^ 0x5EED_BA11);
+                    let sv = self.cfg.motion.jump_sigma_mps;
+                    let particles: Vec<BallState> = (0..self.cfg.particles)
+                        .map(|_| BallState {
+                            position: d.sample_position(&mut rng),
+                            velocity: [sv * rng.normal(), sv * rng.normal(), sv * rng.normal()],
+                        })
+                        .collect();
+                    let mut f = ParticleFilter::new(self.cfg.filter, particles)?;
+                    // Weigh the start by this frame: the detection's depth is rough.
+                    let w: Vec<f64> = f
+                        .particles()
+                        .iter()
+                        .map(|p| ocellus_estimation::particle_filter::Model::log_likelihood(&self.model, p, &self.obs))
+                        .collect();
+                    f.reweight(&w)?;
+                    let ess = f.ess();
+                    self.filter = Some(f);
+                    ess
+                }
+                None => {
+                    return Ok(TrackEstimate {
+                        frame: k,
+                        position: None,
+                        velocity: None,
+                        circle: None,
+                        ess: 0.0,
+                        score: -1.0,
+                        lost: true,
+                        detections: n_det,
+                    })
+                }
+            },
+        };
+        let Some(f) = &self.filter else {
+            return Err(TrackingError::Invalid("the filter did not start".into()));
+        };
+        let position = f.mean(|s| s.position);
+        let velocity = f.mean(|s| s.velocity);
+        let circle = self.model.circle(&BallState { position, velocity });
+        let score = circle.map_or(-1.0, |c| self.model.colour.score(&self.obs.binned, c));
+        Ok(TrackEstimate {
+            frame: k,
+            position: Some(position),
+            velocity: Some(velocity),
+            circle,
+            ess,
+            score,
+            lost: score < self.cfg.lost_score,
+            detections: n_det,
+        })
+    }
+}
