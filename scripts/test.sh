@@ -19,6 +19,7 @@ examples=(
   "ocellus-odometry floor_odometry"
   "ocellus-sim corridor_event"
   "ocellus-eval mit1003_scores"
+  "ocellus-sim ball_study"
 )
 ran=0
 for e in "${examples[@]}"; do
