@@ -86,6 +86,13 @@ impl<T: Copy + Default> Plane<T> {
         &self.data[s..s + self.width]
     }
 
+    /// All pixels in storage order: pixel (x, y) is at `y * stride() + x` (the elements past
+    /// `width` in each row, if the stride is wider, are padding).
+    #[inline]
+    pub fn as_slice(&self) -> &[T] {
+        &self.data
+    }
+
     /// Mutable row `y`.
     #[inline]
     pub fn row_mut(&mut self, y: usize) -> &mut [T] {

@@ -107,7 +107,7 @@ impl MotionModel {
         }
         let (l11, l21, l22) = self.cholesky();
         for k in 0..3 {
-            let (a, b) = (rng.normal(), rng.normal());
+            let (a, b) = rng.normal_pair();
             s.position[k] += l11 * a;
             s.velocity[k] += l21 * a + l22 * b;
         }
