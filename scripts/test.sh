@@ -20,6 +20,7 @@ examples=(
   "ocellus-sim corridor_event"
   "ocellus-eval mit1003_scores"
   "ocellus-sim ball_study"
+  "ocellus-sim stereo_head"
 )
 ran=0
 for e in "${examples[@]}"; do

@@ -167,6 +167,8 @@ const CASES: &[Case] = &[
     c("track {D}/frames --radius-m 0.05 --colour 245,120,25 --out {O}", Usage(&["--camera"])),
     c("track eval {D}/missing.csv {D}/missing.csv", Error(&["missing.csv"])),
     c("track study --seeds 1,x", Error(&["--seeds"])),
+    c("track head --steps 0 --out {O}", Usage(&["--steps", "range"])),
+    c("track head --particles 0 --out {O}", Usage(&["--particles", "range"])),
     c("generate ball --frames 0 --out {O}", Usage(&["--frames", "range"])),
     c("generate ball --frames 10 --occluded-frames 8 --out {O}", Error(&["occlusion", "do not fit"])),
     c("generate ball --noise NaN --out {O}", Usage(&["--noise", "range"])),

@@ -5,6 +5,8 @@
 //!
 //! - [`ball_tracking`]: generated ball worlds tracked by the plain and the boosted particle
 //!   filter, scored against the truth (SPEC 7).
+//! - [`stereo_head`]: an active stereo head keeping a tracked ball in both foveas (saccades on
+//!   the main sequence, smooth pursuit, vergence from the log-polar fovea).
 //! - [`corridor_experiment`]: the seed's corridor (SPEC 2.6): information-based view
 //!   planning switching from landmarks to a suddenly appearing person.
 //!
@@ -22,6 +24,7 @@
 
 pub mod ball_tracking;
 pub mod corridor_experiment;
+pub mod stereo_head;
 
 /// Errors of the simulations.
 #[derive(Debug, thiserror::Error)]
@@ -35,6 +38,9 @@ pub enum SimError {
     /// The scene generator failed.
     #[error(transparent)]
     Synth(#[from] ocellus_synth::SynthError),
+    /// The vergence measurement failed.
+    #[error(transparent)]
+    Fovea(#[from] ocellus_fovea::FoveaError),
     /// The tracker failed.
     #[error(transparent)]
     Tracking(#[from] ocellus_tracking::TrackingError),

@@ -186,6 +186,15 @@ pub struct BallWorld {
 /// Gravity, m/s^2, along +y.
 pub const GRAVITY: f64 = 9.81;
 
+/// The colour of a sphere point `hit` (world), Lambert-shaded by a light from the upper left
+/// with an ambient share of 0.3.
+pub(crate) fn lambert(centre: &Vector3<f64>, hit: &Vector3<f64>, radius: f64, c: [f32; 3]) -> [f32; 3] {
+    let light = Vector3::new(-0.4, -0.6, -0.7).normalize();
+    let n = (hit - centre) / radius;
+    let l = 0.3 + 0.7 * n.dot(&light).max(0.0) as f32;
+    c.map(|v| (v * l).min(255.0))
+}
+
 /// Physics substeps per frame.
 const SUBSTEPS: usize = 50;
 
@@ -360,8 +369,19 @@ impl BallWorld {
         self.occluders.iter().position(|o| x >= o[0] && x < o[2] && y >= o[1] && y < o[3])
     }
 
+    /// The ball's centre and velocity at frame `k` (metres, m/s; world = reference camera
+    /// frame).
+    pub fn state(&self, k: usize) -> Option<([f64; 3], [f64; 3])> {
+        self.states.get(k).copied()
+    }
+
+    /// The background photo as the reference camera sees it (frame size, 0..255 RGB).
+    pub(crate) fn background(&self) -> &Plane<[f32; 3]> {
+        &self.background
+    }
+
     /// The gain per channel at frame `k` (the lighting change).
-    fn gain(&self, k: usize) -> [f32; 3] {
+    pub(crate) fn gain(&self, k: usize) -> [f32; 3] {
         if !self.cfg.lighting_change {
             return [1.0; 3];
         }
@@ -380,12 +400,7 @@ impl BallWorld {
         let r = self.cfg.radius_m;
         let base = self.cfg.colour.map(|c| c as f32);
         let redder = [base[0].min(255.0) * 0.97, base[1] * 0.8, base[2] * 1.3 + 10.0];
-        let light = Vector3::new(-0.4, -0.6, -0.7).normalize();
-        let shade = |centre: &Vector3<f64>, hit: &Vector3<f64>, rad: f64, c: [f32; 3]| -> [f32; 3] {
-            let n = (hit - centre) / rad;
-            let l = 0.3 + 0.7 * n.dot(&light).max(0.0) as f32;
-            c.map(|v| (v * l).min(255.0))
-        };
+        let shade = |centre: &Vector3<f64>, hit: &Vector3<f64>, rad: f64, c: [f32; 3]| lambert(centre, hit, rad, c);
         let spheres: Vec<(Vector3<f64>, [f32; 3], bool)> =
             std::iter::once((ball, base, true)).chain(self.distractor.map(|d| (d, redder, false))).collect();
         let (mut ball_samples, mut ball_visible) = (0usize, 0usize);

@@ -4,6 +4,7 @@
 //!   sensor noise, an object that appears suddenly, a steady camera pan), with per-frame truth.
 //! - [`ball_world`]: a shaded coloured ball flying, bouncing, approaching in 3D in front of a
 //!   real photo, with occluders, a distractor, a lighting change and noise (tracking truth).
+//! - [`ball_view`]: the ball world seen by any moving pinhole camera (the eyes of a stereo head).
 //! - [`chessboard`]: views of a chessboard through a known distorted camera (calibration
 //!   ground truth).
 //! - [`ground`]: a camera looking down at a tiled real-texture floor with known planar motion
@@ -29,6 +30,7 @@
 //! ```
 
 pub mod attention_scenes;
+pub mod ball_view;
 pub mod ball_world;
 pub mod chessboard;
 pub mod corridor;

@@ -143,6 +143,12 @@ impl BallTracker {
         Ok(Self { cfg, model, filter: None, obs: BallFrame::default(), frame: 0 })
     }
 
+    /// Moves the camera (a camera on a moving head: its pose for the next frame, world to
+    /// camera); the particles stay in the world frame.
+    pub fn set_camera(&mut self, camera: PinholeCamera) {
+        self.model.camera = camera;
+    }
+
     /// The model (camera, motion, colour).
     pub fn model(&self) -> &BallModel {
         &self.model
