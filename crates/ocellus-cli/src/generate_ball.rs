@@ -125,6 +125,16 @@ pub fn write_truth_row(w: &mut impl Write, t: &BallTruth) -> std::io::Result<()>
     )
 }
 
+/// The library's occlusion choice.
+pub fn occlusion_of(a: OcclusionArg) -> Occlusion {
+    match a {
+        OcclusionArg::None => Occlusion::None,
+        OcclusionArg::Partial => Occlusion::Partial,
+        OcclusionArg::Full => Occlusion::Full,
+        OcclusionArg::Both => Occlusion::Both,
+    }
+}
+
 /// Runs the subcommand.
 pub fn run(a: BallArgs) -> Result<()> {
     let trajectory = match a.trajectory {
@@ -132,12 +142,7 @@ pub fn run(a: BallArgs) -> Result<()> {
         TrajectoryArg::Bounce => Trajectory::Bounce,
         TrajectoryArg::Approach => Trajectory::Approach,
     };
-    let occlusion = match a.occlusion {
-        OcclusionArg::None => Occlusion::None,
-        OcclusionArg::Partial => Occlusion::Partial,
-        OcclusionArg::Full => Occlusion::Full,
-        OcclusionArg::Both => Occlusion::Both,
-    };
+    let occlusion = occlusion_of(a.occlusion);
     let cfg = BallWorldConfig {
         frames: a.frames,
         fps: a.fps,

@@ -87,12 +87,13 @@ pub fn score_run(truths: &[BallTruth], estimates: &[TrackEstimate]) -> Result<Tr
     Ok(score(&t, &e)?)
 }
 
-/// The world of the study for a trajectory and seed: both occluders, noise sigma 3.
-pub fn study_world_config(trajectory: Trajectory, seed: u64) -> BallWorldConfig {
-    BallWorldConfig { occlusion: Occlusion::Both, ..BallWorldConfig::new(trajectory, seed) }
+/// The world of the study for a trajectory and seed: the given occluders (`Both` in the
+/// study), noise sigma 3.
+pub fn study_world_config(trajectory: Trajectory, seed: u64, occlusion: Occlusion) -> BallWorldConfig {
+    BallWorldConfig { occlusion, ..BallWorldConfig::new(trajectory, seed) }
 }
 
-/// Runs every trajectory x seed with each boost in `boosts` (0 is the plain SIR), the
+/// Runs every trajectory x seed (worlds with `occlusion`) with each boost in `boosts` (0 is the plain SIR), the
 /// tracker otherwise `base`.
 pub fn study(
     background: &Plane<[f32; 3]>,
@@ -101,11 +102,12 @@ pub fn study(
     seeds: &[u64],
     boosts: &[f64],
     base: TrackerConfig,
+    occlusion: Occlusion,
 ) -> Result<Vec<StudyRun>> {
     let mut runs = Vec::new();
     for &trajectory in trajectories {
         for &seed in seeds {
-            let wc = study_world_config(trajectory, seed);
+            let wc = study_world_config(trajectory, seed, occlusion);
             let world = BallWorld::new(wc, background, occluder)?;
             for &boost in boosts {
                 let mut cfg = tracker_config(&wc, base);

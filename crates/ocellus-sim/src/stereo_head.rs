@@ -423,7 +423,7 @@ mod tests {
         let g = Gaze::towards(&ahead, 0.068);
         for side in [-1.0, 1.0] {
             let (r, c) = g.eye(side, 0.068);
-            assert!(foveal_error_deg(&r, &c, &ahead) < 1e-9);
+            assert!(foveal_error_deg(&r, &c, &ahead) < 1e-5, "acos near 1 keeps about 1e-6 deg");
         }
     }
 }

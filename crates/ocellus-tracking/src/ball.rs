@@ -38,6 +38,10 @@ pub fn project_ball(
     project_sphere(camera, distortion, centre, radius_m).map(|[x, y, r]| Circle { x, y, r })
 }
 
+/// Spread of the distance of detection draws that keep the parent's predicted distance, as a
+/// share of it (see [`BallModel`]).
+pub const KEEP_DEPTH_SIGMA_FRAC: f64 = 0.03;
+
 /// What one step of the tracker observes: the binned frame and the bottom-up detections
 /// (empty for the plain filter).
 #[derive(Clone, Debug, Default)]
@@ -52,8 +56,11 @@ pub struct BallFrame {
 ///
 /// The proposal is the mixture of Okuma et al. (ECCV 2004), drawn per particle:
 /// `q(x | x', z) = alpha q_det(x | z, x') + (1 - alpha) p(x | x')`. `q_det` puts the centre
-/// at one of the frame's detections (chosen uniformly, Gaussian about it, see
-/// [`BallDetection`]) and draws the velocity as a jump of the motion model does. The
+/// on the line of sight of one of the frame's detections (chosen uniformly): half the draws
+/// at the blob's own distance (Gaussian about it, see [`BallDetection`]), half at the
+/// parent's predicted distance (spread [`KEEP_DEPTH_SIGMA_FRAC`]), since a blob's size gives
+/// the depth only roughly and a bounce or a hit changes the direction, rarely the depth; it
+/// draws the velocity as a jump of the motion model does. The
 /// importance weight is corrected by `p(x | x') / q(x | x', z)` with both mixtures
 /// evaluated exactly; without detections, or with `boost = 0`, it is the bootstrap filter.
 #[derive(Clone, Debug)]
@@ -70,6 +77,9 @@ pub struct BallModel {
     pub colour: ColourModel,
     /// Share `alpha` of the proposal drawn from the detections, in [0, 1].
     pub boost: f64,
+    /// Spread of a detection draw's velocity about the parent's predicted velocity, across
+    /// and along the detection's line of sight, m/s (see `DetectorConfig`).
+    pub detection_velocity_sigma_mps: [f64; 2],
 }
 
 impl BallModel {
@@ -95,13 +105,28 @@ impl BallModel {
         project_ball(&self.camera, &self.distortion, &Vector3::from(s.position), self.radius_m)
     }
 
-    /// `ln q_det(x | z, x')`: the detections' mixture for the centre, the jump's velocity.
+    /// The predicted distance of `prev` from the camera centre, metres.
+    fn predicted_distance(&self, prev: &BallState) -> f64 {
+        (Vector3::from(self.motion.predict(prev).position) - self.camera.centre()).norm()
+    }
+
+    /// `ln q_det(x | z, x')`: the mixture over the detections of, for the centre, their own
+    /// Gaussian and the one at the parent's predicted distance (each half), and for the
+    /// velocity, the Gaussian about the parent's predicted velocity shaped by that
+    /// detection's line of sight.
     fn log_detection_density(&self, prev: &BallState, s: &BallState, dets: &[BallDetection]) -> f64 {
+        let pred = self.motion.predict(prev);
+        let dist = (Vector3::from(pred.position) - self.camera.centre()).norm();
+        let [across, along] = self.detection_velocity_sigma_mps;
         let mut l = f64::NEG_INFINITY;
         for d in dets {
-            l = log_add(l, d.log_density(&s.position));
+            let pos = log_add(
+                d.log_density(&s.position),
+                d.at_distance(dist, KEEP_DEPTH_SIGMA_FRAC).log_density(&s.position),
+            );
+            l = log_add(l, pos + d.log_velocity_density(&pred.velocity, across, along, &s.velocity));
         }
-        l - (dets.len() as f64).ln() + self.motion.log_jump_velocity_density(prev, s)
+        l - (2.0 * dets.len() as f64).ln()
     }
 }
 
@@ -116,8 +141,13 @@ impl Model for BallModel {
         }
         let alpha = self.boost;
         let state = if rng.unit() < alpha {
-            let d = &dets[rng.below(dets.len())];
-            BallState { position: d.sample_position(rng), velocity: self.motion.sample_jump_velocity(prev, rng) }
+            let mut d = dets[rng.below(dets.len())];
+            if rng.unit() < 0.5 {
+                d = d.at_distance(self.predicted_distance(prev), KEEP_DEPTH_SIGMA_FRAC);
+            }
+            let [across, along] = self.detection_velocity_sigma_mps;
+            let v = self.motion.predict(prev).velocity;
+            BallState { position: d.sample_position(rng), velocity: d.sample_velocity(&v, across, along, rng) }
         } else {
             self.motion.sample(prev, rng)
         };

@@ -45,6 +45,13 @@ pub struct DetectorConfig {
     pub lateral_sigma_radii: f64,
     /// Spread of a detection's distance, as a share of the distance.
     pub depth_sigma_frac: f64,
+    /// Spread of the velocity of a particle drawn from a detection about its parent's
+    /// predicted velocity, across the line of sight, m/s: wide, since the image corrects it
+    /// within a frame or two (after a bounce the direction of flight turns).
+    pub velocity_sigma_across_mps: f64,
+    /// The same along the line of sight, m/s: narrow, since the image hardly sees it (a wide
+    /// one lets the depth run away after a bounce).
+    pub velocity_sigma_along_mps: f64,
 }
 
 impl Default for DetectorConfig {
@@ -57,6 +64,8 @@ impl Default for DetectorConfig {
             min_score: 0.3,
             lateral_sigma_radii: 0.15,
             depth_sigma_frac: 0.12,
+            velocity_sigma_across_mps: 3.0,
+            velocity_sigma_along_mps: 0.5,
         }
     }
 }
@@ -191,6 +200,8 @@ pub struct BallDetection {
     pub position: [f64; 3],
     /// Unit line of sight through the centre, world frame.
     pub direction: [f64; 3],
+    /// Distance of the centre from the camera centre along the line of sight, metres.
+    pub distance_m: f64,
     /// Standard deviation across the line of sight, metres.
     pub sigma_lateral_m: f64,
     /// Standard deviation along the line of sight, metres.
@@ -226,30 +237,67 @@ impl BallDetection {
             circle,
             position: p.into(),
             direction: dir.into(),
+            distance_m: d,
             sigma_lateral_m,
             sigma_depth_m: cfg.depth_sigma_frac * d,
         })
     }
 
+    /// The same line of sight with the centre at `distance_m` instead (spread
+    /// `depth_sigma_frac` of it along the line, the lateral spread scaled with the distance):
+    /// a detection whose depth is taken from elsewhere (the track's prediction), since a
+    /// blob's size gives the depth only roughly.
+    pub fn at_distance(&self, distance_m: f64, depth_sigma_frac: f64) -> Self {
+        let u = Vector3::from(self.direction);
+        let p = Vector3::from(self.position) + (distance_m - self.distance_m) * u;
+        Self {
+            position: p.into(),
+            distance_m,
+            sigma_lateral_m: self.sigma_lateral_m * distance_m / self.distance_m,
+            sigma_depth_m: depth_sigma_frac * distance_m,
+            ..*self
+        }
+    }
+
     /// Draws a centre from the detection's Gaussian.
     pub fn sample_position(&self, rng: &mut SplitMix64) -> [f64; 3] {
-        let u = Vector3::from(self.direction);
-        let (e1, e2) = basis(&u);
-        let p = Vector3::from(self.position)
-            + self.sigma_lateral_m * (rng.normal() * e1 + rng.normal() * e2)
-            + self.sigma_depth_m * rng.normal() * u;
-        p.into()
+        sample_about_line(&self.position, &self.direction, self.sigma_lateral_m, self.sigma_depth_m, rng)
     }
 
     /// `ln` of the detection's Gaussian density at `position`.
     pub fn log_density(&self, position: &[f64; 3]) -> f64 {
-        let u = Vector3::from(self.direction);
-        let d = Vector3::from(*position) - Vector3::from(self.position);
-        let along = d.dot(&u);
-        let across2 = (d - along * u).norm_squared();
-        let (sl, sd) = (self.sigma_lateral_m, self.sigma_depth_m);
-        -1.5 * LN_2PI - 2.0 * sl.ln() - sd.ln() - 0.5 * (across2 / (sl * sl) + along * along / (sd * sd))
+        log_density_about_line(&self.position, &self.direction, self.sigma_lateral_m, self.sigma_depth_m, position)
     }
+
+    /// Draws a velocity about `mean` (m/s): `across` m/s across this line of sight, `along`
+    /// m/s along it.
+    pub fn sample_velocity(&self, mean: &[f64; 3], across: f64, along: f64, rng: &mut SplitMix64) -> [f64; 3] {
+        sample_about_line(mean, &self.direction, across, along, rng)
+    }
+
+    /// `ln` of the density of [`Self::sample_velocity`] at `v`.
+    pub fn log_velocity_density(&self, mean: &[f64; 3], across: f64, along: f64, v: &[f64; 3]) -> f64 {
+        log_density_about_line(mean, &self.direction, across, along, v)
+    }
+}
+
+/// A draw of the Gaussian about `mean` with spread `across` perpendicular to the unit
+/// `direction` and `along` on it.
+fn sample_about_line(mean: &[f64; 3], direction: &[f64; 3], across: f64, along: f64, rng: &mut SplitMix64) -> [f64; 3] {
+    let u = Vector3::from(*direction);
+    let (e1, e2) = basis(&u);
+    let (a, b) = rng.normal_pair();
+    let p = Vector3::from(*mean) + across * (a * e1 + b * e2) + along * rng.normal() * u;
+    p.into()
+}
+
+/// `ln` of that Gaussian's density at `x`.
+fn log_density_about_line(mean: &[f64; 3], direction: &[f64; 3], across: f64, along: f64, x: &[f64; 3]) -> f64 {
+    let u = Vector3::from(*direction);
+    let d = Vector3::from(*x) - Vector3::from(*mean);
+    let on = d.dot(&u);
+    let off2 = (d - on * u).norm_squared();
+    -1.5 * LN_2PI - 2.0 * across.ln() - along.ln() - 0.5 * (off2 / (across * across) + on * on / (along * along))
 }
 
 /// The 3D hypotheses of the blobs of the ball's colour in `frame` whose circles score at
@@ -341,6 +389,7 @@ mod tests {
             circle: Circle { x: 0.0, y: 0.0, r: 10.0 },
             position: [0.2, 0.1, 2.0],
             direction: Vector3::new(0.1, 0.05, 1.0).normalize().into(),
+            distance_m: 2.0,
             sigma_lateral_m: 0.01,
             sigma_depth_m: 0.2,
         };

@@ -138,7 +138,18 @@ impl BallTracker {
             )));
         }
         colour.lambda = cfg.lambda;
-        let model = BallModel { camera, distortion, radius_m, motion: cfg.motion, colour, boost: cfg.boost };
+        let model = BallModel {
+            camera,
+            distortion,
+            radius_m,
+            motion: cfg.motion,
+            colour,
+            boost: cfg.boost,
+            detection_velocity_sigma_mps: [
+                cfg.detector.velocity_sigma_across_mps,
+                cfg.detector.velocity_sigma_along_mps,
+            ],
+        };
         model.validate()?;
         Ok(Self { cfg, model, filter: None, obs: BallFrame::default(), frame: 0 })
     }
@@ -185,11 +196,14 @@ impl BallTracker {
             None => match self.best_detection() {
                 Some(d) => {
                     let mut rng = SplitMix64::new(self.cfg.filter.seed ^ 0x5EED_BA11);
-                    let sv = self.cfg.motion.jump_sigma_mps;
+                    // Position from the detection; velocity unknown: the detection draws'
+                    // spread about rest (wide across the line of sight, narrow along it).
+                    let (across, along) =
+                        (self.cfg.detector.velocity_sigma_across_mps, self.cfg.detector.velocity_sigma_along_mps);
                     let particles: Vec<BallState> = (0..self.cfg.particles)
                         .map(|_| BallState {
                             position: d.sample_position(&mut rng),
-                            velocity: [sv * rng.normal(), sv * rng.normal(), sv * rng.normal()],
+                            velocity: d.sample_velocity(&[0.0; 3], across, along, &mut rng),
                         })
                         .collect();
                     let mut f = ParticleFilter::new(self.cfg.filter, particles)?;

@@ -35,7 +35,15 @@ fn scene() -> Result<(Plane<[u8; 3]>, BallModel, Vector3<f64>)> {
         }
     });
     let colour = ColourModel::from_patch(&frame, Circle { r: 0.8 * c.r, ..c })?;
-    let model = BallModel { camera, distortion, radius_m: 0.05, motion: MotionModel::at_fps(30.0), colour, boost: 0.0 };
+    let model = BallModel {
+        camera,
+        distortion,
+        radius_m: 0.05,
+        motion: MotionModel::at_fps(30.0),
+        colour,
+        boost: 0.0,
+        detection_velocity_sigma_mps: [3.0, 0.5],
+    };
     Ok((frame, model, ball))
 }
 
