@@ -30,6 +30,12 @@ impl Intrinsics {
         Ok(Self { fx: f, fy: f, cx, cy, skew: 0.0 })
     }
 
+    /// Square pixels of focal length `focal_px`, no skew, the principal point at the centre
+    /// of a `width` x `height` image (pixel centres at integers: ((w - 1) / 2, (h - 1) / 2)).
+    pub fn centred(focal_px: f64, width: usize, height: usize) -> Self {
+        Self { fx: focal_px, fy: focal_px, cx: (width as f64 - 1.0) / 2.0, cy: (height as f64 - 1.0) / 2.0, skew: 0.0 }
+    }
+
     /// The calibration matrix K.
     pub fn matrix(&self) -> Matrix3<f64> {
         Matrix3::new(self.fx, self.skew, self.cx, 0.0, self.fy, self.cy, 0.0, 0.0, 1.0)

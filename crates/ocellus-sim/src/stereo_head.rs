@@ -224,13 +224,7 @@ pub fn run_head(
         )));
     }
     let dt = 1.0 / cfg.control_hz;
-    let k = Intrinsics {
-        fx: cfg.focal_px,
-        fy: cfg.focal_px,
-        cx: (cfg.eye_width as f64 - 1.0) / 2.0,
-        cy: (cfg.eye_height as f64 - 1.0) / 2.0,
-        skew: 0.0,
-    };
+    let k = Intrinsics::centred(cfg.focal_px, cfg.eye_width, cfg.eye_height);
     let (w, h) = (cfg.eye_width, cfg.eye_height);
     let b = cfg.baseline_m;
     // The head starts looking straight ahead at 2 m: its first move is a saccade to the ball.

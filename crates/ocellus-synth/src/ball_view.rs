@@ -7,7 +7,7 @@
 //! samples and Lambert shading, plus the world's lighting change and sensor noise. Occluders
 //! and the distractor of the reference view are not part of these views.
 
-use crate::ball_world::{lambert, BallWorld};
+use crate::ball_world::{circle_box, lambert, BallWorld, SUBSAMPLES};
 use crate::{Result, SynthError};
 use nalgebra::{Vector2, Vector3};
 use ocellus_geometry::camera::PinholeCamera;
@@ -58,16 +58,13 @@ pub fn render_view(
         let s = (BACKGROUND_DEPTH_M - centre.z) / d.z;
         bg_at(&(centre + s * d))
     });
-    if let Some([cx, cy, cr]) = project_sphere(camera, &Distortion::default(), &ball, r) {
-        let (x0, x1) =
-            ((cx - cr - 2.0).floor().max(0.0) as usize, ((cx + cr + 2.0).ceil().max(0.0) as usize).min(width));
-        let (y0, y1) =
-            ((cy - cr - 2.0).floor().max(0.0) as usize, ((cy + cr + 2.0).ceil().max(0.0) as usize).min(height));
-        for y in y0..y1 {
-            for x in x0..x1 {
+    if let Some(circle) = project_sphere(camera, &Distortion::default(), &ball, r) {
+        let (xs, ys) = circle_box(circle, 2.0, width, height);
+        for y in ys {
+            for x in xs.clone() {
                 let mut acc = [0.0f32; 3];
                 let mut hits = 0;
-                for (sx, sy) in [(-0.25, -0.25), (0.25, -0.25), (-0.25, 0.25), (0.25, 0.25)] {
+                for (sx, sy) in SUBSAMPLES {
                     let d = ray(x as f64 + sx, y as f64 + sy);
                     if let Some(t) = ray_sphere(&centre, &d, &ball, r) {
                         let c = lambert(&ball, &(centre + t * d), r, colour);

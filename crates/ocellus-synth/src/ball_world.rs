@@ -111,13 +111,7 @@ impl BallWorldConfig {
 
     /// The camera (world = camera frame).
     pub fn camera(&self) -> PinholeCamera {
-        let k = Intrinsics {
-            fx: self.focal_px,
-            fy: self.focal_px,
-            cx: (self.width as f64 - 1.0) / 2.0,
-            cy: (self.height as f64 - 1.0) / 2.0,
-            skew: 0.0,
-        };
+        let k = Intrinsics::centred(self.focal_px, self.width, self.height);
         PinholeCamera { k, r: Matrix3::identity(), t: Vector3::zeros() }
     }
 
@@ -193,6 +187,22 @@ pub(crate) fn lambert(centre: &Vector3<f64>, hit: &Vector3<f64>, radius: f64, c:
     let n = (hit - centre) / radius;
     let l = 0.3 + 0.7 * n.dot(&light).max(0.0) as f32;
     c.map(|v| (v * l).min(255.0))
+}
+
+/// The 2x2 sample offsets of a pixel, pixels.
+pub(crate) const SUBSAMPLES: [(f64, f64); 4] = [(-0.25, -0.25), (0.25, -0.25), (-0.25, 0.25), (0.25, 0.25)];
+
+/// The pixel columns and rows of a `w` x `h` image within `margin` pixels of the circle
+/// `[x, y, r]`.
+pub(crate) fn circle_box(
+    [cx, cy, cr]: [f64; 3],
+    margin: f64,
+    w: usize,
+    h: usize,
+) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+    let lo = |c: f64| (c - cr - margin).floor().max(0.0) as usize;
+    let hi = |c: f64, n: usize| ((c + cr + margin).ceil().max(0.0) as usize).min(n);
+    (lo(cx)..hi(cx, w), lo(cy)..hi(cy, h))
 }
 
 /// Physics substeps per frame.
@@ -406,15 +416,12 @@ impl BallWorld {
         let (mut ball_samples, mut ball_visible) = (0usize, 0usize);
         for (centre, _, _) in &spheres {
             let Some([cx, cy, cr]) = project_sphere(&self.camera, &self.cfg.distortion, centre, r) else { continue };
-            let (x0, x1) =
-                ((cx - cr - 3.0).floor().max(0.0) as usize, ((cx + cr + 3.0).ceil().max(0.0) as usize).min(w));
-            let (y0, y1) =
-                ((cy - cr - 3.0).floor().max(0.0) as usize, ((cy + cr + 3.0).ceil().max(0.0) as usize).min(h));
-            for y in y0..y1 {
-                for x in x0..x1 {
+            let (xs, ys) = circle_box([cx, cy, cr], 3.0, w, h);
+            for y in ys {
+                for x in xs.clone() {
                     let mut acc = [0.0f32; 3];
                     let mut hits = 0;
-                    for (sx, sy) in [(-0.25, -0.25), (0.25, -0.25), (-0.25, 0.25), (0.25, 0.25)] {
+                    for (sx, sy) in SUBSAMPLES {
                         let (px, py) = (x as f64 + sx, y as f64 + sy);
                         let Ok((ux, uy)) = self.cfg.distortion.undistort_pixel(&self.camera.k, px, py) else {
                             continue;
