@@ -135,6 +135,12 @@ struct StudyArgs {
     /// Occluders in the sequences.
     #[arg(long, value_enum, default_value = "both")]
     occlusion: crate::generate_ball::OcclusionArg,
+    /// Add the static, redder distractor ball to every sequence.
+    #[arg(long)]
+    distractor: bool,
+    /// Add the lighting change to every sequence.
+    #[arg(long)]
+    lighting_change: bool,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
@@ -439,9 +445,13 @@ fn run_study(a: &StudyArgs) -> Result<()> {
     let mut base = TrackerConfig::at_fps(30.0);
     base.particles = a.particles;
     let trajectories = [Trajectory::Throw, Trajectory::Bounce, Trajectory::Approach];
-    let occlusion = crate::generate_ball::occlusion_of(a.occlusion);
+    let scene = ocellus_sim::ball_tracking::StudyScene {
+        occlusion: crate::generate_ball::occlusion_of(a.occlusion),
+        distractor: a.distractor,
+        lighting_change: a.lighting_change,
+    };
     let runs =
-        study(&photo("rocket.jpg")?, &photo("gravel.png")?, &trajectories, &seeds, &[0.0, a.boost], base, occlusion)?;
+        study(&photo("rocket.jpg")?, &photo("gravel.png")?, &trajectories, &seeds, &[0.0, a.boost], base, scene)?;
     if a.json {
         outln!("{}", serde_json::to_string(&serde_json::json!({ "particles": a.particles, "runs": runs }))?);
         return Ok(());

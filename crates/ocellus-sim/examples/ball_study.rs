@@ -5,15 +5,15 @@
 //!
 //! `cargo run --release -p ocellus-sim --example ball_study`
 
-use ocellus_sim::ball_tracking::{score_run, study_world_config, track_world, tracker_config};
-use ocellus_synth::ball_world::{BallWorld, Occlusion, Trajectory};
+use ocellus_sim::ball_tracking::{score_run, study_world_config, track_world, tracker_config, StudyScene};
+use ocellus_synth::ball_world::{BallWorld, Trajectory};
 use ocellus_tracking::tracker::TrackerConfig;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let load = |n: &str| -> Result<_, Box<dyn std::error::Error>> {
         Ok(ocellus_io::read_image(ocellus_testdata::asset(n))?.to_u8().map(|p| p.map(f32::from)))
     };
-    let wc = study_world_config(Trajectory::Throw, 1, Occlusion::Both);
+    let wc = study_world_config(Trajectory::Throw, 1, StudyScene::default());
     let world = BallWorld::new(wc, &load("rocket.jpg")?, &load("gravel.png")?)?;
     for boost in [0.0, 0.2] {
         let mut cfg = tracker_config(&wc, TrackerConfig::at_fps(wc.fps));

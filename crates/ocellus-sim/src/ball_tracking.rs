@@ -87,13 +87,35 @@ pub fn score_run(truths: &[BallTruth], estimates: &[TrackEstimate]) -> Result<Tr
     Ok(score(&t, &e)?)
 }
 
-/// The world of the study for a trajectory and seed: the given occluders (`Both` in the
-/// study), noise sigma 3.
-pub fn study_world_config(trajectory: Trajectory, seed: u64, occlusion: Occlusion) -> BallWorldConfig {
-    BallWorldConfig { occlusion, ..BallWorldConfig::new(trajectory, seed) }
+/// What the study's worlds hold besides the ball.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct StudyScene {
+    /// Occluders (`Both` in the study).
+    pub occlusion: Occlusion,
+    /// A static, redder second ball.
+    pub distractor: bool,
+    /// The light dimming mid-sequence.
+    pub lighting_change: bool,
 }
 
-/// Runs every trajectory x seed (worlds with `occlusion`) with each boost in `boosts` (0 is the plain SIR), the
+impl Default for StudyScene {
+    /// Both occluders, no distractor, steady light.
+    fn default() -> Self {
+        Self { occlusion: Occlusion::Both, distractor: false, lighting_change: false }
+    }
+}
+
+/// The world of the study for a trajectory and seed: `scene`, noise sigma 3.
+pub fn study_world_config(trajectory: Trajectory, seed: u64, scene: StudyScene) -> BallWorldConfig {
+    BallWorldConfig {
+        occlusion: scene.occlusion,
+        distractor: scene.distractor,
+        lighting_change: scene.lighting_change,
+        ..BallWorldConfig::new(trajectory, seed)
+    }
+}
+
+/// Runs every trajectory x seed (worlds holding `scene`) with each boost in `boosts` (0 is the plain SIR), the
 /// tracker otherwise `base`.
 pub fn study(
     background: &Plane<[f32; 3]>,
@@ -102,12 +124,12 @@ pub fn study(
     seeds: &[u64],
     boosts: &[f64],
     base: TrackerConfig,
-    occlusion: Occlusion,
+    scene: StudyScene,
 ) -> Result<Vec<StudyRun>> {
     let mut runs = Vec::new();
     for &trajectory in trajectories {
         for &seed in seeds {
-            let wc = study_world_config(trajectory, seed, occlusion);
+            let wc = study_world_config(trajectory, seed, scene);
             let world = BallWorld::new(wc, background, occluder)?;
             for &boost in boosts {
                 let mut cfg = tracker_config(&wc, base);
