@@ -202,6 +202,7 @@ pub fn run(a: TrackArgs) -> Result<()> {
     let mut tracker: Option<BallTracker> = None;
     let mut video: Option<VideoWriter> = None;
     let mut estimates = Vec::new();
+    let mut first_size: Option<(usize, usize)> = None;
     let pinhole = PinholeCamera { k: cam.intrinsics, r: nalgebra::Matrix3::identity(), t: nalgebra::Vector3::zeros() };
     let t0 = std::time::Instant::now();
     let n = for_each_frame(input, None, |k, frame| {
@@ -214,9 +215,10 @@ pub fn run(a: TrackArgs) -> Result<()> {
                 (None, None) => bail!("no colour model"),
             };
             tracker = Some(BallTracker::new(cfg, pinhole, cam.distortion, radius_m, model)?);
-        } else if f.size() != estimates_size(&cam, &f) {
+        } else if Some(f.size()) != first_size {
             bail!("frame {k} is {}x{}, unlike the first frame", f.width(), f.height());
         }
+        first_size.get_or_insert(f.size());
         let Some(tr) = tracker.as_mut() else { bail!("no tracker") };
         let e = tr.process(&f)?;
         write_row(&mut csv, &e, a.fps)?;
@@ -262,11 +264,6 @@ pub fn run(a: TrackArgs) -> Result<()> {
         outln!("wrote {}", a.out.join("error.png").display());
     }
     Ok(())
-}
-
-/// The size the camera was calibrated for, or the frame's own.
-fn estimates_size(cam: &camera_file::CameraFile, f: &Plane<[u8; 3]>) -> (usize, usize) {
-    cam.image_size.map_or(f.size(), |[w, h]| (w, h))
 }
 
 fn write_row(w: &mut impl Write, e: &TrackEstimate, fps: f64) -> Result<()> {

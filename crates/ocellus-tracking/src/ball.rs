@@ -105,18 +105,12 @@ impl BallModel {
         project_ball(&self.camera, &self.distortion, &Vector3::from(s.position), self.radius_m)
     }
 
-    /// The predicted distance of `prev` from the camera centre, metres.
-    fn predicted_distance(&self, prev: &BallState) -> f64 {
-        (Vector3::from(self.motion.predict(prev).position) - self.camera.centre()).norm()
-    }
-
     /// `ln q_det(x | z, x')`: the mixture over the detections of, for the centre, their own
     /// Gaussian and the one at the parent's predicted distance (each half), and for the
     /// velocity, the Gaussian about the parent's predicted velocity shaped by that
-    /// detection's line of sight.
-    fn log_detection_density(&self, prev: &BallState, s: &BallState, dets: &[BallDetection]) -> f64 {
-        let pred = self.motion.predict(prev);
-        let dist = (Vector3::from(pred.position) - self.camera.centre()).norm();
+    /// detection's line of sight. `pred` is the parent's noise-free prediction, `dist` its
+    /// distance from the camera centre.
+    fn log_detection_density(&self, pred: &BallState, dist: f64, s: &BallState, dets: &[BallDetection]) -> f64 {
         let [across, along] = self.detection_velocity_sigma_mps;
         let mut l = f64::NEG_INFINITY;
         for d in dets {
@@ -140,19 +134,24 @@ impl Model for BallModel {
             return Draw { state: self.motion.sample(prev, rng), log_prior_over_proposal: 0.0 };
         }
         let alpha = self.boost;
+        let pred = self.motion.predict(prev);
+        let dist = (Vector3::from(pred.position) - self.camera.centre()).norm();
         let state = if rng.unit() < alpha {
             let mut d = dets[rng.below(dets.len())];
             if rng.unit() < 0.5 {
-                d = d.at_distance(self.predicted_distance(prev), KEEP_DEPTH_SIGMA_FRAC);
+                d = d.at_distance(dist, KEEP_DEPTH_SIGMA_FRAC);
             }
             let [across, along] = self.detection_velocity_sigma_mps;
-            let v = self.motion.predict(prev).velocity;
-            BallState { position: d.sample_position(rng), velocity: d.sample_velocity(&v, across, along, rng) }
+            BallState {
+                position: d.sample_position(rng),
+                velocity: d.sample_velocity(&pred.velocity, across, along, rng),
+            }
         } else {
             self.motion.sample(prev, rng)
         };
         let log_p = self.motion.log_density(prev, &state);
-        let log_q = log_add(alpha.ln() + self.log_detection_density(prev, &state, dets), (1.0 - alpha).ln() + log_p);
+        let log_q =
+            log_add(alpha.ln() + self.log_detection_density(&pred, dist, &state, dets), (1.0 - alpha).ln() + log_p);
         let ratio = log_p - log_q;
         // Both are finite for a finite state; a state at infinity is impossible.
         Draw { state, log_prior_over_proposal: if ratio.is_nan() { f64::NEG_INFINITY } else { ratio } }

@@ -175,12 +175,6 @@ impl BallTracker {
         &self.obs.detections
     }
 
-    /// The detection to start from: the best colour score of its circle.
-    fn best_detection(&self) -> Option<BallDetection> {
-        let score = |d: &BallDetection| self.model.colour.score(&self.obs.binned, d.circle);
-        self.obs.detections.iter().copied().max_by(|a, b| score(a).total_cmp(&score(b)))
-    }
-
     /// Takes one frame: bins it, detects blobs, then starts the filter from the best
     /// detection or steps it.
     pub fn process(&mut self, frame: &Plane<[u8; 3]>) -> Result<TrackEstimate> {
@@ -193,7 +187,8 @@ impl BallTracker {
         let n_det = self.obs.detections.len();
         let ess = match &mut self.filter {
             Some(f) => f.step(&self.model, &self.obs)?.ess,
-            None => match self.best_detection() {
+            // `detect_balls` orders the detections by colour score: start from the best.
+            None => match self.obs.detections.first().copied() {
                 Some(d) => {
                     let mut rng = SplitMix64::new(self.cfg.filter.seed ^ 0x5EED_BA11);
                     // Position from the detection; velocity unknown: the detection draws'
