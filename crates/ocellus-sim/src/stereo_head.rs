@@ -30,6 +30,7 @@ use nalgebra::{Matrix3, Vector3};
 use ocellus_fovea::vergence::{VergenceOptions, VergenceTracker};
 use ocellus_geometry::camera::{Intrinsics, PinholeCamera};
 use ocellus_geometry::distortion::Distortion;
+use ocellus_image::convert::RgbImage;
 use ocellus_image::Plane;
 use ocellus_synth::ball_view::render_view;
 use ocellus_synth::ball_world::{BallWorld, GRAVITY};
@@ -273,7 +274,9 @@ pub fn run_head(
         let est = tr.process(&left)?;
         // Vergence: the disparity at the left fovea.
         let fovea = [k.cx, k.cy];
-        let v = vergence.update(&left.map(luma8), &right.map(luma8), fovea)?;
+        // The workspace's one 8-bit luma (a copy of each 320x240 eye: small next to rendering it).
+        let grey = |p: &Plane<[u8; 3]>| RgbImage::U8(p.clone()).to_luma8();
+        let v = vergence.update(&grey(&left), &grey(&right), fovea)?;
         let target = est.position.map(|p| Gaze::towards(&Vector3::from(p), b));
         // Gaze.
         let in_saccade = saccade.is_some();
@@ -376,11 +379,6 @@ impl HeadRun {
 /// Saccades in a run: steps with a saccade under way whose previous step had none.
 pub fn saccade_count(steps: &[HeadStep]) -> usize {
     steps.iter().enumerate().filter(|(i, s)| s.saccade && (*i == 0 || !steps[i - 1].saccade)).count()
-}
-
-/// 8-bit luma of an RGB pixel (BT.601, as `ocellus_image::convert`).
-fn luma8(p: [u8; 3]) -> u8 {
-    (ocellus_image::convert::luma(p.map(|v| v as f32 / 255.0)) * 255.0).round().clamp(0.0, 255.0) as u8
 }
 
 #[cfg(test)]
