@@ -85,6 +85,42 @@ fn walk(w: &[f64], m: usize, u: impl Fn(usize) -> f64, out: &mut Vec<usize>) {
     }
 }
 
+/// Slots each particle of a systematic pass writes unconditionally (one cache line of `usize`).
+const FILL: usize = 8;
+
+/// The particle loop of [`systematic`] over `w` (all particles before the last with weight):
+/// fills `out` (of length at least `n + FILL`) up to the returned bound and returns the CDF
+/// at the end of `w`, that bound, and whether a weight was negative or not finite. The
+/// AVX2 build writes a particle's slots in two stores instead of four; the arithmetic is
+/// the same (no contraction into FMA), so every backend gives the same parents.
+#[allow(clippy::extra_unused_type_parameters)]
+#[inline(always)]
+fn systematic_fill_generic<M: ocellus_image::simd::Madd>(
+    w: &[f64],
+    u: f64,
+    n: usize,
+    out: &mut [usize],
+) -> (f64, usize, bool) {
+    let (nf, mut c, mut done, mut bad) = (n as f64, 0.0, 0usize, false);
+    for (i, &wi) in w.iter().enumerate() {
+        bad |= !(0.0..f64::INFINITY).contains(&wi);
+        c += wi;
+        out[done..done + FILL].fill(i);
+        // N c - u >= -1, so truncating N c - u + 1 is the floor plus one (`floor` itself is a
+        // libm call on the x86-64 baseline). A zero weight keeps the bound: it owns nothing.
+        let upto = ((nf * c - u + 1.0) as usize).min(n);
+        if upto > done + FILL {
+            out[done + FILL..upto].fill(i);
+        }
+        done = if wi > 0.0 { upto.max(done) } else { done };
+    }
+    (c, done, bad)
+}
+
+ocellus_image::dispatch_kernel!(
+    fn systematic_fill => systematic_fill_generic(w: &[f64], u: f64, n: usize, out: &mut [usize]) -> (f64, usize, bool)
+);
+
 /// Systematic resampling, the seed's Algorithm 2: `u_j = (u + j) / N` for j = 0..N with
 /// `u` uniform in [0, 1) (the caller's draw, so that the scheme itself is deterministic).
 pub fn systematic(w: &[f64], u: f64, out: &mut Vec<usize>) -> Result<()> {
@@ -97,40 +133,33 @@ pub fn systematic(w: &[f64], u: f64, out: &mut Vec<usize>) -> Result<()> {
     // The walk of Algorithm 2 branches once per point and once per particle, unpredictably
     // for uneven weights (about 15 ns per particle at 10^6). The same assignment without
     // data-dependent branches: the points u_j <= c_i are j < floor(N c_i - u) + 1, so the
-    // range of particle i starts where the previous bound ended. Each particle marks the
-    // start of its range with its index (a later particle with the same start overwrites an
-    // empty range's mark), and a running maximum spreads the marks over the ranges. At 10^6
-    // particles this is memory bound, so the weights are checked in the same pass rather than
-    // in one of their own (`check`, for the other schemes).
+    // range of particle i starts where the previous bound `done` ended. Each particle
+    // writes its index into the FILL slots from `done` on, unconditionally (one cache line,
+    // no branch); only a range longer than that, rare once N w_i < FILL, takes a loop. What
+    // it writes past its range lies at or after the next particle's start, which overwrites
+    // it, so out[..done] is final at every step. The output is written once (no zeroing
+    // pass, no second pass), and the weights are checked in the same pass rather than in one
+    // of their own (`check`, for the others). What remains is the CDF's serial sum, kept
+    // serial so that the parents equal those of the seed's walk bit for bit.
     let n = w.len();
     let last = w.iter().rposition(|&v| v > 0.0).unwrap_or(n - 1);
-    // One slot past the end takes the marks of particles after the last point.
-    out.clear();
-    out.resize(n + 1, 0);
-    let (nf, mut c, mut done, mut bad) = (n as f64, 0.0, 0usize, false);
-    for (i, &wi) in w.iter().enumerate().take(last) {
-        bad |= !(0.0..f64::INFINITY).contains(&wi);
-        c += wi;
-        out[done] = i;
-        // N c - u >= -1, so truncating N c - u + 1 is the floor plus one (`floor` itself is a
-        // libm call on the x86-64 baseline). A zero weight keeps the bound: it owns nothing.
-        let upto = ((nf * c - u + 1.0) as usize).min(n);
-        done = if wi > 0.0 { upto.max(done) } else { done };
+    // FILL slots of slack past the end for the unconditional writes; their old contents
+    // are overwritten, so a reused buffer is not cleared.
+    if out.len() < n + FILL {
+        out.resize(n + FILL, 0);
+    } else {
+        out.truncate(n + FILL);
     }
+    let (c, done, bad) = systematic_fill(ocellus_image::Backend::Auto, &w[..last], u, n, out);
     // The last particle with weight takes the rest: the round-off guard.
-    out[done] = last;
+    out[done..n].fill(last);
     out.truncate(n);
     let tail = &w[last..];
-    bad |= tail.iter().any(|v| !(0.0..f64::INFINITY).contains(v));
+    let bad = bad || tail.iter().any(|v| !(0.0..f64::INFINITY).contains(v));
     let total = c + tail.iter().sum::<f64>();
     if bad || (total - 1.0).abs() > 1e-9 {
         out.clear();
         return check(w);
-    }
-    let mut top = 0;
-    for v in out.iter_mut() {
-        top = top.max(*v);
-        *v = top;
     }
     Ok(())
 }
@@ -320,6 +349,25 @@ mod tests {
             systematic(&w, u, &mut fast).unwrap();
             walk(&w, n, |j| (u + j as f64) / n as f64, &mut slow);
             assert_eq!(fast, slow, "case {case}");
+        }
+    }
+
+    #[test]
+    fn every_backend_gives_the_same_systematic_parents() {
+        let mut rng = SplitMix64::new(7);
+        for case in 0..300 {
+            let n = 1 + case * 7 % 500;
+            let w = random_weights(n, &mut rng, case % 2 == 0);
+            let u = rng.unit();
+            let runs: Vec<_> = ocellus_image::Backend::available()
+                .into_iter()
+                .map(|b| {
+                    let mut out = vec![usize::MAX; n + FILL];
+                    let r = systematic_fill(b, &w[..n - 1], u, n, &mut out);
+                    (r, out[..r.1].to_vec())
+                })
+                .collect();
+            assert!(runs.windows(2).all(|p| p[0] == p[1]), "case {case}");
         }
     }
 
