@@ -25,6 +25,7 @@ mod output_files;
 mod plan_cmd;
 mod plot;
 mod ranges;
+mod retina_cmd;
 mod saliency_cmd;
 mod stereo_cmd;
 mod surprise_cmd;
@@ -94,6 +95,9 @@ enum Command {
     /// by colour-blob detections) on frames; `track eval` scores a track against truth;
     /// `track study` prints the accuracy figures on generated sequences.
     Track(track_cmd::TrackArgs),
+    /// What should my retina be: learn receptive fields, motor fields and predictors from
+    /// self-induced image changes (the self-organizing retina, the seed's two experiments).
+    Retina(retina_cmd::RetinaArgs),
     /// Print benchmark figures (median ms per frame, fps on all cores, per stage, peak memory).
     Bench(bench::BenchArgs),
 }
@@ -130,6 +134,7 @@ fn main() {
         Command::Odometry(a) => odometry_cmd::run(a),
         Command::Logpolar(a) => logpolar_cmd::run(a),
         Command::Track(a) => track_cmd::run(a),
+        Command::Retina(a) => retina_cmd::run(a),
     };
     let r = r.and_then(|()| Ok(out::flush_stdout()?));
     if let Err(e) = r {

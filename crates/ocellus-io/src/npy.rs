@@ -103,21 +103,39 @@ pub fn read(path: impl AsRef<Path>) -> Result<NpyArray> {
 
 /// Encodes `data` (C order) with `shape` as `<f4` `.npy` bytes.
 pub fn encode_f32(shape: &[usize], data: &[f32]) -> Vec<u8> {
+    encode("<f4", shape, data.len() * 4, data.iter().flat_map(|v| v.to_le_bytes()))
+}
+
+/// Encodes `data` (C order) with `shape` as `<f8` `.npy` bytes (exact f64, for state that
+/// must be restored bit for bit).
+pub fn encode_f64(shape: &[usize], data: &[f64]) -> Vec<u8> {
+    encode("<f8", shape, data.len() * 8, data.iter().flat_map(|v| v.to_le_bytes()))
+}
+
+/// Writes `data` (C order) with `shape` as an `<f4` `.npy` file.
+pub fn write_f32(path: impl AsRef<Path>, shape: &[usize], data: &[f32]) -> Result<()> {
+    write_bytes(path.as_ref(), &encode_f32(shape, data))
+}
+
+/// Writes `data` (C order) with `shape` as an `<f8` `.npy` file.
+pub fn write_f64(path: impl AsRef<Path>, shape: &[usize], data: &[f64]) -> Result<()> {
+    write_bytes(path.as_ref(), &encode_f64(shape, data))
+}
+
+fn encode(descr: &str, shape: &[usize], bytes: usize, data: impl Iterator<Item = u8>) -> Vec<u8> {
     let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
     let shape_s = if dims.len() == 1 { format!("({},)", dims[0]) } else { format!("({})", dims.join(", ")) };
-    let mut header = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {shape_s}, }}");
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape_s}, }}");
     // Pad so that the data starts on a 64-byte boundary; the header ends with '\n'.
     while (10 + header.len() + 1) % 64 != 0 {
         header.push(' ');
     }
     header.push('\n');
-    let mut out = Vec::with_capacity(10 + header.len() + data.len() * 4);
+    let mut out = Vec::with_capacity(10 + header.len() + bytes);
     out.extend_from_slice(b"\x93NUMPY\x01\x00");
     out.extend_from_slice(&(header.len() as u16).to_le_bytes());
     out.extend_from_slice(header.as_bytes());
-    for v in data {
-        out.extend_from_slice(&v.to_le_bytes());
-    }
+    out.extend(data);
     out
 }
 

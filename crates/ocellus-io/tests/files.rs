@@ -93,6 +93,12 @@ fn npy_reads_fortran_order_and_round_trips() {
     let back = npy::read(&f).unwrap();
     assert_eq!(back.shape, vec![3, 4]);
     assert_eq!(back.data, p.to_vec().iter().map(|&v| v as f64).collect::<Vec<_>>());
+    // f64 arrays of any rank come back bit for bit.
+    let v: Vec<f64> = (0..24).map(|i| (i as f64).sqrt() * 1e-7 - 3.0).collect();
+    let f = tmp("v.npy");
+    npy::write_f64(&f, &[2, 3, 4], &v).unwrap();
+    let back = npy::read(&f).unwrap();
+    assert_eq!((back.shape, back.data), (vec![2, 3, 4], v));
 }
 
 #[test]

@@ -1,0 +1,320 @@
+//! Actions and their motor codes (SPEC 8.1).
+//!
+//! An action moves the eye; the pixel at offset p afterwards shows the source point
+//! `c + T(p)` of the image, with c the gaze point before it:
+//! - shift by (dx, dy) pixels: `T(p) = p + (dx, dy)`;
+//! - rotate by theta and dilate by log-scale s (zoom in by e^s): `T(p) = e^-s R(theta) p`,
+//!   R rotating from +x towards +y.
+//!
+//! The 2D motor space holds (dx, dy) in pixels for translations and (theta in radians, s) for
+//! rotation + dilation. The motor code q of an action is either one-hot over a list of
+//! discrete action values (experiment 1: one fixed motor field per value) or the bilinear
+//! weights of its point over a grid of motor cells spanning the space (experiment 2:
+//! 15 x 15 cells), a population code that sums to 1.
+
+use crate::{Result, RetinaError};
+
+/// What an action does.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum Action {
+    /// Shift by (dx, dy) pixels.
+    Shift {
+        /// Pixels, +x right.
+        dx: f64,
+        /// Pixels, +y down.
+        dy: f64,
+    },
+    /// Rotate by `theta` radians and dilate by log-scale `s`.
+    RotateDilate {
+        /// Radians, from +x towards +y.
+        theta: f64,
+        /// Natural log of the zoom factor.
+        s: f64,
+    },
+}
+
+impl Action {
+    /// Where the pixel at offset `p` samples the source after the action, relative to the
+    /// gaze point before it.
+    pub fn map(&self, p: [f64; 2]) -> [f64; 2] {
+        match *self {
+            Action::Shift { dx, dy } => [p[0] + dx, p[1] + dy],
+            Action::RotateDilate { theta, s } => {
+                let (sn, cs) = theta.sin_cos();
+                let k = (-s).exp();
+                [k * (cs * p[0] - sn * p[1]), k * (sn * p[0] + cs * p[1])]
+            }
+        }
+    }
+
+    /// The action's point in its 2D motor space.
+    pub fn motor_point(&self) -> [f64; 2] {
+        match *self {
+            Action::Shift { dx, dy } => [dx, dy],
+            Action::RotateDilate { theta, s } => [theta, s],
+        }
+    }
+
+    /// How far any pixel within `radius` of the gaze point may sample from it, pixels.
+    pub fn reach(&self, radius: f64) -> f64 {
+        match *self {
+            Action::Shift { dx, dy } => radius + dx.hypot(dy),
+            Action::RotateDilate { s, .. } => radius * (-s).exp(),
+        }
+    }
+}
+
+/// Which actions an experiment uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ActionKinds {
+    /// Horizontal and vertical shifts.
+    Translation,
+    /// Rotations and dilations.
+    RotationDilation,
+    /// All four (experiment 1 only: its motor fields are one per value, no shared 2D space).
+    All,
+}
+
+impl std::str::FromStr for ActionKinds {
+    type Err = RetinaError;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "translation" => Ok(Self::Translation),
+            "rotation-dilation" => Ok(Self::RotationDilation),
+            "all" => Ok(Self::All),
+            _ => Err(RetinaError::Invalid(format!("actions '{s}': use translation, rotation-dilation or all"))),
+        }
+    }
+}
+
+impl ActionKinds {
+    /// Name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Translation => "translation",
+            Self::RotationDilation => "rotation-dilation",
+            Self::All => "all",
+        }
+    }
+}
+
+/// Largest action magnitudes, relative to the disc radius `r` pixels: shifts up to r / 2
+/// pixels, rotations up to 30 degrees, dilations up to e^0.3 (1.35x). At the rim the
+/// largest rotation moves a pixel by 0.52 r and the largest dilation by 0.26-0.35 r: the
+/// two action sets displace the periphery about equally, so only their geometry differs.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ActionRanges {
+    /// Largest shift, pixels.
+    pub shift_px: f64,
+    /// Largest rotation, radians.
+    pub rotation_rad: f64,
+    /// Largest |log-scale|.
+    pub log_scale: f64,
+}
+
+impl ActionRanges {
+    /// The defaults for a disc of radius `r` pixels.
+    pub fn for_radius(r: f64) -> Self {
+        Self { shift_px: 0.5 * r, rotation_rad: 30f64.to_radians(), log_scale: 0.3 }
+    }
+
+    /// Checks the ranges are finite and positive.
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [("shift", self.shift_px), ("rotation", self.rotation_rad), ("log-scale", self.log_scale)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(RetinaError::Invalid(format!("largest {name} {v} must be finite and positive")));
+            }
+        }
+        Ok(())
+    }
+
+    /// The `count` discrete action values of experiment 1, spread evenly over the kinds:
+    /// for two kinds, each axis gets `count / 2` values `+-j max / (count / 4)`, j = 1..;
+    /// for all four, each kind gets `m = count / 4` values `(-1)^j (j + 1) max / m`.
+    pub fn discrete(&self, kinds: ActionKinds, count: usize) -> Result<Vec<Action>> {
+        self.validate()?;
+        let per_axis = match kinds {
+            ActionKinds::All => 4,
+            _ => 2,
+        };
+        if count == 0 || count % (2 * per_axis) != 0 && kinds != ActionKinds::All || count % per_axis != 0 {
+            return Err(RetinaError::Invalid(format!(
+                "{count} action values cannot be spread evenly over the {} actions",
+                kinds.name()
+            )));
+        }
+        let m = count / per_axis;
+        // Signed magnitudes in (0, 1], never the zero action (it would repeat across axes):
+        // +-1/h, ..., +-1 for two kinds; 1/m, -2/m, 3/m, ... for all four (m may be odd).
+        let signed: Vec<f64> = match kinds {
+            ActionKinds::All => {
+                (0..m).map(|j| if j % 2 == 0 { 1.0 } else { -1.0 } * (j + 1) as f64 / m as f64).collect()
+            }
+            _ => {
+                let h = m / 2;
+                (1..=h).flat_map(|j| [-(j as f64) / h as f64, j as f64 / h as f64]).collect()
+            }
+        };
+        let (t, r, l) = (self.shift_px, self.rotation_rad, self.log_scale);
+        let mut out = Vec::with_capacity(count);
+        let shift = |out: &mut Vec<Action>| {
+            out.extend(signed.iter().map(|&v| Action::Shift { dx: v * t, dy: 0.0 }));
+            out.extend(signed.iter().map(|&v| Action::Shift { dx: 0.0, dy: v * t }));
+        };
+        let rotdil = |out: &mut Vec<Action>| {
+            out.extend(signed.iter().map(|&v| Action::RotateDilate { theta: v * r, s: 0.0 }));
+            out.extend(signed.iter().map(|&v| Action::RotateDilate { theta: 0.0, s: v * l }));
+        };
+        match kinds {
+            ActionKinds::Translation => shift(&mut out),
+            ActionKinds::RotationDilation => rotdil(&mut out),
+            ActionKinds::All => {
+                shift(&mut out);
+                rotdil(&mut out);
+            }
+        }
+        Ok(out)
+    }
+
+    /// The motor space's extent [lo, hi] per axis for a 2D action kind.
+    pub fn extent(&self, kinds: ActionKinds) -> Result<[[f64; 2]; 2]> {
+        self.validate()?;
+        match kinds {
+            ActionKinds::Translation => Ok([[-self.shift_px, self.shift_px], [-self.shift_px, self.shift_px]]),
+            ActionKinds::RotationDilation => {
+                Ok([[-self.rotation_rad, self.rotation_rad], [-self.log_scale, self.log_scale]])
+            }
+            ActionKinds::All => Err(RetinaError::Invalid(
+                "a 2D motor space holds translations or rotation + dilation, not all four actions".into(),
+            )),
+        }
+    }
+
+    /// A uniform random action of a 2D kind, from two uniforms in [0, 1).
+    pub fn uniform(&self, kinds: ActionKinds, u: [f64; 2]) -> Result<Action> {
+        let e = self.extent(kinds)?;
+        let a = e[0][0] + u[0] * (e[0][1] - e[0][0]);
+        let b = e[1][0] + u[1] * (e[1][1] - e[1][0]);
+        Ok(match kinds {
+            ActionKinds::Translation => Action::Shift { dx: a, dy: b },
+            _ => Action::RotateDilate { theta: a, s: b },
+        })
+    }
+}
+
+/// How an action becomes the motor vector q.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum MotorCode {
+    /// One cell per listed action value (compared exactly).
+    OneHot(Vec<Action>),
+    /// A `cells x cells` grid spanning `extent`; an action's point spreads bilinearly over
+    /// the four nearest cell centres (cell centres at the grid's nodes, edges included).
+    Grid {
+        /// Cells per axis (>= 2).
+        cells: usize,
+        /// [lo, hi] of each motor axis.
+        extent: [[f64; 2]; 2],
+    },
+}
+
+impl MotorCode {
+    /// Number of motor cells (the length of q).
+    pub fn len(&self) -> usize {
+        match self {
+            MotorCode::OneHot(v) => v.len(),
+            MotorCode::Grid { cells, .. } => cells * cells,
+        }
+    }
+
+    /// True when there are no cells.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Writes q for `action` into `q` (length [`len`](Self::len)).
+    pub fn encode(&self, action: &Action, q: &mut [f64]) -> Result<()> {
+        q.iter_mut().for_each(|v| *v = 0.0);
+        match self {
+            MotorCode::OneHot(values) => {
+                let i = values
+                    .iter()
+                    .position(|v| v == action)
+                    .ok_or_else(|| RetinaError::Invalid(format!("{action:?} is not one of the motor values")))?;
+                q[i] = 1.0;
+            }
+            MotorCode::Grid { cells, extent } => {
+                let n = *cells;
+                if n < 2 {
+                    return Err(RetinaError::Invalid(format!("a motor grid needs at least 2 cells per axis, not {n}")));
+                }
+                let p = action.motor_point();
+                let mut idx = [(0usize, 0.0f64); 2];
+                for a in 0..2 {
+                    let [lo, hi] = extent[a];
+                    let t = (p[a] - lo) / (hi - lo) * (n - 1) as f64;
+                    if !(t.is_finite() && (-1e-9..=(n - 1) as f64 + 1e-9).contains(&t)) {
+                        return Err(RetinaError::Invalid(format!("{action:?} lies outside the motor space")));
+                    }
+                    let t = t.clamp(0.0, (n - 1) as f64);
+                    let i = (t.floor() as usize).min(n - 2);
+                    idx[a] = (i, t - i as f64);
+                }
+                let ((ix, fx), (iy, fy)) = (idx[0], idx[1]);
+                q[iy * n + ix] += (1.0 - fx) * (1.0 - fy);
+                q[iy * n + ix + 1] += fx * (1.0 - fy);
+                q[(iy + 1) * n + ix] += (1.0 - fx) * fy;
+                q[(iy + 1) * n + ix + 1] += fx * fy;
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn actions_map_points_as_defined() {
+        let a = Action::RotateDilate { theta: std::f64::consts::FRAC_PI_2, s: 2f64.ln() };
+        // A quarter turn takes +x to +y; zooming in 2x halves the sampling offset.
+        let q = a.map([4.0, 0.0]);
+        assert!((q[0]).abs() < 1e-12 && (q[1] - 2.0).abs() < 1e-12);
+        assert_eq!(Action::Shift { dx: 1.5, dy: -2.0 }.map([1.0, 1.0]), [2.5, -1.0]);
+    }
+
+    #[test]
+    fn experiment_one_has_sixty_distinct_values() {
+        let r = ActionRanges::for_radius(30.23);
+        for kinds in [ActionKinds::Translation, ActionKinds::RotationDilation, ActionKinds::All] {
+            let v = r.discrete(kinds, 60).unwrap();
+            assert_eq!(v.len(), 60);
+            for i in 0..60 {
+                for j in 0..i {
+                    assert_ne!(v[i], v[j], "{kinds:?} {i} {j}");
+                }
+            }
+        }
+        assert!(r.discrete(ActionKinds::Translation, 58).is_err());
+    }
+
+    #[test]
+    fn grid_codes_are_bilinear_and_sum_to_one() {
+        let code = MotorCode::Grid { cells: 15, extent: [[-1.0, 1.0], [-2.0, 2.0]] };
+        let mut q = vec![0.0; 225];
+        // A node: all weight on one cell.
+        code.encode(&Action::Shift { dx: -1.0, dy: -2.0 }, &mut q).unwrap();
+        assert_eq!(q[0], 1.0);
+        code.encode(&Action::Shift { dx: 0.03, dy: 1.1 }, &mut q).unwrap();
+        assert!((q.iter().sum::<f64>() - 1.0).abs() < 1e-12 && q.iter().filter(|&&v| v > 0.0).count() <= 4);
+        // The weighted mean of the cell centres is the point itself.
+        let (mut x, mut y) = (0.0, 0.0);
+        for (i, w) in q.iter().enumerate() {
+            x += w * (-1.0 + 2.0 * (i % 15) as f64 / 14.0);
+            y += w * (-2.0 + 4.0 * (i / 15) as f64 / 14.0);
+        }
+        assert!((x - 0.03).abs() < 1e-12 && (y - 1.1).abs() < 1e-12);
+        assert!(code.encode(&Action::Shift { dx: 1.5, dy: 0.0 }, &mut q).is_err());
+    }
+}

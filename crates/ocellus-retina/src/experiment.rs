@@ -1,0 +1,262 @@
+//! The seed's two experiments (SPEC 8.3) and reduced versions of them.
+//!
+//! 1. **Sensor design**: 60 fixed motor fields, one per action value (M = identity, q
+//!    one-hot), 68 triplets per value (4080), 2877 pixels, 48 receptive fields: S 138,096 +
+//!    P 138,240 = 276,336 variables (the seed: "about 275,000").
+//! 2. **Co-development**: a 15 x 15 grid of motor cells over the 2D motor space (225), 481
+//!    pixels, 16 receptive fields and 16 motor fields, all learned; 22,500 triplets with
+//!    uniform random actions: S 7,696 + M 3,600 + P 4,096 = 15,392 (the seed: "about
+//!    15,000").
+//!
+//! Held-out triplets come from the same images at other gaze points (another seed), so the
+//! held-out error measures the prediction, not the memory of patches.
+
+use crate::action::{Action, ActionKinds, ActionRanges, MotorCode};
+use crate::disc::Disc;
+use crate::experience::{render, Experience};
+use crate::model::{fit_scale, Free, Params, Shape};
+use crate::{Real, Result, RetinaError};
+use ocellus_image::rng::SplitMix64;
+use ocellus_image::Plane;
+
+/// Which experiment, and its sizes.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ExperimentConfig {
+    /// 1 (sensor design: fixed motor fields) or 2 (co-development: motor fields learned).
+    pub experiment: u8,
+    /// Pixels of the disc.
+    pub pixels: usize,
+    /// Receptive fields.
+    pub fields: usize,
+    /// Experiment 1: action values (= fixed motor fields); experiment 2: motor fields.
+    pub motor_fields: usize,
+    /// Experiment 2: motor cells per axis of the grid (225 = 15 x 15).
+    pub grid_cells: usize,
+    /// Experiment 1: triplets per action value; experiment 2: triplets in all.
+    pub triplets: usize,
+    /// Held-out triplets (experiment 1: per action value).
+    pub heldout: usize,
+    /// The actions.
+    pub actions: ActionKinds,
+    /// Weight of the simplicity term.
+    pub simplicity: f64,
+    /// Seed of the experience (gaze points, images, random actions) and of the start.
+    pub seed: u64,
+}
+
+impl ExperimentConfig {
+    /// The seed's experiment 1 at its size.
+    pub fn sensor_design(actions: ActionKinds) -> Self {
+        Self {
+            experiment: 1,
+            pixels: 2877,
+            fields: 48,
+            motor_fields: 60,
+            grid_cells: 0,
+            triplets: 68,
+            heldout: 17,
+            actions,
+            simplicity: DEFAULT_SIMPLICITY,
+            seed: 1,
+        }
+    }
+
+    /// The seed's experiment 2 at its size.
+    pub fn co_development(actions: ActionKinds) -> Self {
+        Self {
+            experiment: 2,
+            pixels: 481,
+            fields: 16,
+            motor_fields: 16,
+            grid_cells: 15,
+            triplets: 22_500,
+            heldout: 2_500,
+            actions,
+            simplicity: DEFAULT_SIMPLICITY,
+            seed: 1,
+        }
+    }
+
+    /// Experiment 1 reduced for tests: 481 pixels, 16 fields, 20 action values x 24
+    /// triplets.
+    pub fn sensor_design_small(actions: ActionKinds) -> Self {
+        Self { pixels: 481, fields: 16, motor_fields: 20, triplets: 24, heldout: 8, ..Self::sensor_design(actions) }
+    }
+
+    /// Checks the sizes and the weight.
+    pub fn validate(&self) -> Result<()> {
+        if !matches!(self.experiment, 1 | 2) {
+            return Err(RetinaError::Invalid(format!("experiment {}: there are experiments 1 and 2", self.experiment)));
+        }
+        if self.experiment == 2 && self.actions == ActionKinds::All {
+            return Err(RetinaError::Invalid(
+                "experiment 2 has a 2D motor space: use translation or rotation-dilation actions".into(),
+            ));
+        }
+        if self.experiment == 2 && self.grid_cells < 2 {
+            return Err(RetinaError::Invalid(format!(
+                "a motor grid needs at least 2 cells per axis, not {}",
+                self.grid_cells
+            )));
+        }
+        if self.triplets == 0 || self.heldout == 0 {
+            return Err(RetinaError::Invalid("an experiment needs training and held-out triplets".into()));
+        }
+        if !(self.simplicity.is_finite() && self.simplicity >= 0.0) {
+            return Err(RetinaError::Invalid(format!("simplicity weight {} must be finite and >= 0", self.simplicity)));
+        }
+        self.shape().validate()
+    }
+
+    /// The model's sizes.
+    pub fn shape(&self) -> Shape {
+        let motor_cells = if self.experiment == 1 { self.motor_fields } else { self.grid_cells * self.grid_cells };
+        Shape { pixels: self.pixels, fields: self.fields, motor_fields: self.motor_fields, motor_cells }
+    }
+
+    /// Which blocks are learned.
+    pub fn free(&self) -> Free {
+        Free { s: true, m: self.experiment == 2, p: true }
+    }
+
+    /// The number of learned variables.
+    pub fn variables(&self) -> usize {
+        let [s, m, p] = self.shape().sizes();
+        s + p + if self.experiment == 2 { m } else { 0 }
+    }
+}
+
+/// Default weight lambda of the simplicity term.
+pub const DEFAULT_SIMPLICITY: f64 = 1e-3;
+
+/// An experiment ready to learn: the disc, the motor code and the experiences.
+#[derive(Clone, Debug)]
+pub struct Setup<T> {
+    /// The settings.
+    pub config: ExperimentConfig,
+    /// The sensor.
+    pub disc: Disc,
+    /// The action ranges.
+    pub ranges: ActionRanges,
+    /// The motor code.
+    pub code: MotorCode,
+    /// Training triplets.
+    pub train: Experience<T>,
+    /// Held-out triplets.
+    pub heldout: Experience<T>,
+}
+
+/// Builds the experiences from grey source images ([0, 1]).
+pub fn setup<T: Real>(config: &ExperimentConfig, sources: &[Plane<f32>]) -> Result<Setup<T>> {
+    config.validate()?;
+    let disc = Disc::with_pixels(config.pixels)?;
+    let ranges = ActionRanges::for_radius(disc.radius());
+    let (code, train_actions, held_actions) = if config.experiment == 1 {
+        let values = ranges.discrete(config.actions, config.motor_fields)?;
+        let rep = |k: usize| values.iter().flat_map(|a| std::iter::repeat(*a).take(k)).collect::<Vec<Action>>();
+        (MotorCode::OneHot(values.clone()), rep(config.triplets), rep(config.heldout))
+    } else {
+        let extent = ranges.extent(config.actions)?;
+        let mut rng = SplitMix64::new(config.seed ^ 0xA5A5_5A5A);
+        let mut draw = |n: usize| -> Result<Vec<Action>> {
+            (0..n).map(|_| ranges.uniform(config.actions, [rng.unit(), rng.unit()])).collect()
+        };
+        let (a, b) = (draw(config.triplets)?, draw(config.heldout)?);
+        (MotorCode::Grid { cells: config.grid_cells, extent }, a, b)
+    };
+    let train = render(sources, &disc, &train_actions, &code, config.seed)?;
+    let heldout = render(sources, &disc, &held_actions, &code, config.seed.wrapping_add(0x5EED_0F4E_1D00))?;
+    Ok(Setup { config: *config, disc, ranges, code, train, heldout })
+}
+
+/// How the learning starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Init {
+    /// Every entry uniform random (see [`Params::random`]): every field starts as a noisy
+    /// average of the whole disc, and the fields must first break their symmetry.
+    Uniform,
+    /// Each receptive field starts as a Gaussian blob at a centre drawn uniformly over the
+    /// disc's area, its width drawn uniformly from 0.5 to 1.5 times the width at which the
+    /// fields would tile the disc, independently of the centre (so the start has no relation
+    /// of size to eccentricity, no fovea, by construction), plus a floor of 1 % noise; each
+    /// row sums to 1. The predictors start near "nothing changes" (P_k = I plus 10 % noise)
+    /// and the motor fields (when learned) uniform random. The default: it skips the slow
+    /// symmetry breaking of `Uniform`.
+    Blobs,
+}
+
+impl std::str::FromStr for Init {
+    type Err = RetinaError;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "uniform" => Ok(Self::Uniform),
+            "blobs" => Ok(Self::Blobs),
+            _ => Err(RetinaError::Invalid(format!("init '{s}': use blobs or uniform"))),
+        }
+    }
+}
+
+/// The seeded starting point, its predictors scaled to fit the data (see [`fit_scale`]).
+pub fn start<T: Real>(setup: &Setup<T>, init: Init, seed: u64) -> Result<Params<T>> {
+    let c = &setup.config;
+    let shape = c.shape();
+    let mut p = Params::random(shape, c.experiment == 1, seed)?;
+    if init == Init::Blobs {
+        let mut rng = SplitMix64::new(seed ^ 0xB10B);
+        let (n, r) = (shape.pixels, shape.fields);
+        let radius = setup.disc.radius().max(0.5);
+        let tile = (n as f64 / (std::f64::consts::PI * r as f64)).sqrt();
+        for i in 0..r {
+            let (rho, phi) = (radius * rng.unit().sqrt(), std::f64::consts::TAU * rng.unit());
+            let (cx, cy) = (rho * phi.cos(), rho * phi.sin());
+            let w = tile * (0.5 + rng.unit());
+            let row = &mut p.s[i * n..(i + 1) * n];
+            let mut sum = 0.0;
+            let vals: Vec<f64> = setup
+                .disc
+                .offsets()
+                .iter()
+                .map(|&[x, y]| {
+                    let d2 = (x as f64 - cx).powi(2) + (y as f64 - cy).powi(2);
+                    let v = (-d2 / (2.0 * w * w)).exp() + 0.01 * rng.unit();
+                    sum += v;
+                    v
+                })
+                .collect();
+            for (o, v) in row.iter_mut().zip(vals) {
+                *o = T::from_f64(v / sum);
+            }
+        }
+        for k in 0..shape.motor_fields {
+            for a in 0..r {
+                for b in 0..r {
+                    let v = if a == b { 1.0 } else { 0.0 } + 0.1 * rng.unit();
+                    p.p[(k * r + a) * r + b] = T::from_f64(v);
+                }
+            }
+        }
+    }
+    fit_scale(&setup.train, &mut p);
+    Ok(p)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_variable_counts_are_the_seeds() {
+        let one = ExperimentConfig::sensor_design(ActionKinds::Translation);
+        assert_eq!(one.shape().sizes()[0], 138_096);
+        assert_eq!(one.shape().sizes()[2], 138_240);
+        assert_eq!(one.variables(), 276_336);
+        assert_eq!(one.motor_fields * one.triplets, 4080);
+        let two = ExperimentConfig::co_development(ActionKinds::RotationDilation);
+        assert_eq!(two.shape().sizes(), [7_696, 3_600, 4_096]);
+        assert_eq!(two.variables(), 15_392);
+        assert!(ExperimentConfig { actions: ActionKinds::All, ..two }.validate().is_err());
+        assert!(ExperimentConfig { fields: 0, ..one }.validate().is_err());
+        assert!(ExperimentConfig { simplicity: f64::NAN, ..one }.validate().is_err());
+    }
+}
