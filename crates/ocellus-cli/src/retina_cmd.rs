@@ -94,6 +94,10 @@ struct LearnArgs {
     /// Seed of the experience and of the start.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Gaussian blur of the source images before sampling (the eye's optics), sigma in
+    /// pixels. Range: 0..=50.
+    #[arg(long, default_value_t = ocellus_retina::experiment::DEFAULT_BLUR_PX, value_parser = ranges::within(0.0f64, 50.0))]
+    blur: f64,
     /// Also learn the baseline with a random fixed S (only P, and M in experiment 2); on by
     /// default, `--baseline false` skips it.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
@@ -167,6 +171,7 @@ fn learn(a: LearnArgs) -> Result<()> {
     };
     cfg.seed = a.seed;
     cfg.simplicity = a.simplicity;
+    cfg.blur_px = a.blur;
     cfg.validate()?;
     let src = sources(a.images.as_deref())?;
     outln!(

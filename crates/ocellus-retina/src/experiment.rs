@@ -42,6 +42,9 @@ pub struct ExperimentConfig {
     pub simplicity: f64,
     /// Seed of the experience (gaze points, images, random actions) and of the start.
     pub seed: u64,
+    /// Gaussian blur of the source images before sampling (the eye's optics), sigma in
+    /// pixels; 0 for none.
+    pub blur_px: f64,
 }
 
 impl ExperimentConfig {
@@ -58,6 +61,7 @@ impl ExperimentConfig {
             actions,
             simplicity: DEFAULT_SIMPLICITY,
             seed: 1,
+            blur_px: DEFAULT_BLUR_PX,
         }
     }
 
@@ -74,6 +78,7 @@ impl ExperimentConfig {
             actions,
             simplicity: DEFAULT_SIMPLICITY,
             seed: 1,
+            blur_px: DEFAULT_BLUR_PX,
         }
     }
 
@@ -105,6 +110,9 @@ impl ExperimentConfig {
         if !(self.simplicity.is_finite() && self.simplicity >= 0.0) {
             return Err(RetinaError::Invalid(format!("simplicity weight {} must be finite and >= 0", self.simplicity)));
         }
+        if !(self.blur_px.is_finite() && (0.0..=50.0).contains(&self.blur_px)) {
+            return Err(RetinaError::Invalid(format!("blur sigma {} px must lie in [0, 50]", self.blur_px)));
+        }
         self.shape().validate()
     }
 
@@ -128,6 +136,9 @@ impl ExperimentConfig {
 
 /// Default weight lambda of the simplicity term.
 pub const DEFAULT_SIMPLICITY: f64 = 1e-3;
+
+/// Default blur of the sources, pixels (none).
+pub const DEFAULT_BLUR_PX: f64 = 0.0;
 
 /// An experiment ready to learn: the disc, the motor code and the experiences.
 #[derive(Clone, Debug)]
@@ -163,6 +174,17 @@ pub fn setup<T: Real>(config: &ExperimentConfig, sources: &[Plane<f32>]) -> Resu
         };
         let (a, b) = (draw(config.triplets)?, draw(config.heldout)?);
         (MotorCode::Grid { cells: config.grid_cells, extent }, a, b)
+    };
+    let blurred: Vec<Plane<f32>>;
+    let sources = if config.blur_px > 0.0 {
+        blurred = sources
+            .iter()
+            .map(|p| ocellus_image::filter::gaussian_blur(ocellus_image::Backend::Auto, p, config.blur_px as f32))
+            .collect::<std::result::Result<_, _>>()
+            .map_err(|e| RetinaError::Invalid(format!("blurring the sources: {e}")))?;
+        &blurred[..]
+    } else {
+        sources
     };
     let train = render(sources, &disc, &train_actions, &code, config.seed)?;
     let heldout = render(sources, &disc, &held_actions, &code, config.seed.wrapping_add(0x5EED_0F4E_1D00))?;

@@ -5,6 +5,7 @@ mod geometry;
 mod logpolar;
 mod odometry;
 mod planning;
+mod retina;
 mod saliency;
 mod timing;
 mod tracking;
@@ -36,6 +37,9 @@ pub enum Target {
     /// Particle filters: one SIR step of the 3D ball tracker on a 640x480 frame for 10^2..10^5
     /// particles, and resampling 10^6 particles with each scheme.
     Tracking,
+    /// The self-organizing retina: ms per gradient evaluation and per solver iteration for
+    /// both of the seed's experiments at their sizes, all threads and one; peak memory.
+    Retina,
 }
 
 /// Arguments of `ocellus bench`.
@@ -86,7 +90,7 @@ impl BenchArgs {
             Target::Attention => &["--frames"],
             Target::Planning => &["--frames", "--backend"],
             Target::Geometry | Target::Odometry | Target::Logpolar => &["--backend"],
-            Target::Tracking => &[],
+            Target::Tracking | Target::Retina => &[],
         };
         let unused: Vec<&str> = given.iter().filter(|(n, g)| *g && !used.contains(n)).map(|(n, _)| *n).collect();
         if !unused.is_empty() {
@@ -116,6 +120,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         Target::Odometry => return odometry::run(a.json, backend),
         Target::Logpolar => return logpolar::run(a.json, backend),
         Target::Tracking => return tracking::run(a.json),
+        Target::Retina => return retina::run(a.json),
         Target::Saliency => {}
     }
     saliency::run(&a, backend, n)
