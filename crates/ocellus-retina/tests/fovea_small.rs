@@ -2,6 +2,7 @@
 //! on the built-in photographs and textures: from the same random start, rotation and
 //! dilation actions grow the fields with eccentricity (a positive fovea index) while
 //! translations do not, and the learned predictor beats the identity on held-out triplets.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
 use ocellus_retina::action::ActionKinds;
 use ocellus_retina::experiment::{setup, start, ExperimentConfig, Init};

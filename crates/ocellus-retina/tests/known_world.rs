@@ -1,6 +1,7 @@
 //! A world with a known answer: a ring of 8 pixels whose actions shift it cyclically by one
 //! and by two pixels. The best predictor of each action is then the shift matrix itself,
 //! with zero error; the learning must find it.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
 use ocellus_image::rng::SplitMix64;
 use ocellus_retina::action::Action;
