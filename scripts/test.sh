@@ -21,6 +21,7 @@ examples=(
   "ocellus-eval mit1003_scores"
   "ocellus-sim ball_study"
   "ocellus-sim stereo_head"
+  "ocellus-retina retina_fovea"
 )
 ran=0
 for e in "${examples[@]}"; do
