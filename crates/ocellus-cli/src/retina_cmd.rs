@@ -98,6 +98,10 @@ struct LearnArgs {
     /// pixels. Range: 0..=50.
     #[arg(long, default_value_t = ocellus_retina::experiment::DEFAULT_BLUR_PX, value_parser = ranges::within(0.0f64, 50.0))]
     blur: f64,
+    /// Factor on the largest actions (shifts of half the disc radius, rotations of 30
+    /// degrees, dilations by e^0.3). Range: 0.05..=5.
+    #[arg(long, default_value_t = 1.0, value_parser = ranges::within(0.05f64, 5.0))]
+    action_scale: f64,
     /// Also learn the baseline with a random fixed S (only P, and M in experiment 2); on by
     /// default, `--baseline false` skips it.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
@@ -172,6 +176,7 @@ fn learn(a: LearnArgs) -> Result<()> {
     cfg.seed = a.seed;
     cfg.simplicity = a.simplicity;
     cfg.blur_px = a.blur;
+    cfg.action_scale = a.action_scale;
     cfg.validate()?;
     let src = sources(a.images.as_deref())?;
     outln!(

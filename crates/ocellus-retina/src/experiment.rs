@@ -45,6 +45,9 @@ pub struct ExperimentConfig {
     /// Gaussian blur of the source images before sampling (the eye's optics), sigma in
     /// pixels; 0 for none.
     pub blur_px: f64,
+    /// Factor on the default largest actions of [`ActionRanges::for_radius`] (shift r / 2,
+    /// rotation 30 degrees, log-scale 0.3).
+    pub action_scale: f64,
 }
 
 impl ExperimentConfig {
@@ -62,6 +65,7 @@ impl ExperimentConfig {
             simplicity: DEFAULT_SIMPLICITY,
             seed: 1,
             blur_px: DEFAULT_BLUR_PX,
+            action_scale: 1.0,
         }
     }
 
@@ -79,6 +83,7 @@ impl ExperimentConfig {
             simplicity: DEFAULT_SIMPLICITY,
             seed: 1,
             blur_px: DEFAULT_BLUR_PX,
+            action_scale: 1.0,
         }
     }
 
@@ -109,6 +114,9 @@ impl ExperimentConfig {
         }
         if !(self.simplicity.is_finite() && self.simplicity >= 0.0) {
             return Err(RetinaError::Invalid(format!("simplicity weight {} must be finite and >= 0", self.simplicity)));
+        }
+        if !(self.action_scale.is_finite() && self.action_scale > 0.0 && self.action_scale <= 5.0) {
+            return Err(RetinaError::Invalid(format!("action scale {} must lie in (0, 5]", self.action_scale)));
         }
         if !(self.blur_px.is_finite() && (0.0..=50.0).contains(&self.blur_px)) {
             return Err(RetinaError::Invalid(format!("blur sigma {} px must lie in [0, 50]", self.blur_px)));
@@ -161,7 +169,10 @@ pub struct Setup<T> {
 pub fn setup<T: Real>(config: &ExperimentConfig, sources: &[Plane<f32>]) -> Result<Setup<T>> {
     config.validate()?;
     let disc = Disc::with_pixels(config.pixels)?;
-    let ranges = ActionRanges::for_radius(disc.radius());
+    let d = ActionRanges::for_radius(disc.radius());
+    let k = config.action_scale;
+    let ranges =
+        ActionRanges { shift_px: k * d.shift_px, rotation_rad: k * d.rotation_rad, log_scale: k * d.log_scale };
     let (code, train_actions, held_actions) = if config.experiment == 1 {
         let values = ranges.discrete(config.actions, config.motor_fields)?;
         let rep = |k: usize| values.iter().flat_map(|a| std::iter::repeat(*a).take(k)).collect::<Vec<Action>>();
