@@ -486,12 +486,18 @@ fn write_outputs(out: &Path, su: &Setup<f32>, runs: &[Run], layout: &Layout) -> 
         )?;
     }
     let colours = [RGBColor(30, 90, 200), RGBColor(220, 80, 20)];
+    let best =
+        runs.iter().filter_map(|r| r.state.history.last().map(|h| h.cost)).fold(f64::INFINITY, f64::min).max(1e-12);
     let series: Vec<Series> = runs
         .iter()
         .zip(colours)
         .map(|(r, color)| Series {
             label: if r.method == Method::Pgd { "PGD (spectral, line search)" } else { "Adam + projection" },
-            points: r.state.history.iter().map(|h| (h.seconds, h.cost)).collect(),
+            // At most about 300 markers per curve: thousands of iterations would draw a rope.
+            points: {
+                let step = (r.state.history.len() / 300).max(1);
+                r.state.history.iter().step_by(step).map(|h| (h.seconds, h.cost)).collect()
+            },
             color,
         })
         .collect();
@@ -503,7 +509,8 @@ fn write_outputs(out: &Path, su: &Setup<f32>, runs: &[Run], layout: &Layout) -> 
             y_label: "cost",
             series: &series,
             threshold: None,
-            y_range: None,
+            // The first iterations fall by an order of magnitude; show the part that differs.
+            y_range: Some((0.0, 4.0 * best)),
         },
     )?;
     Ok(())
