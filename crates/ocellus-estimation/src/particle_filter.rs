@@ -89,6 +89,8 @@ pub struct ParticleFilter<S> {
     weights: Vec<f64>,
     parents: Vec<usize>,
     next: Vec<S>,
+    /// Whether `propose` ran since the last weighing.
+    proposed: bool,
 }
 
 /// A generator for (seed, step, stream): SplitMix64 of a mixed key, so streams do not overlap
@@ -130,6 +132,7 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
             weights: Vec::new(),
             parents: Vec::new(),
             next: Vec::new(),
+            proposed: false,
         })
     }
 
@@ -188,6 +191,40 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
         m
     }
 
+    /// The first half of [`Self::step`]: moves every particle by the proposal and keeps its
+    /// prior-over-proposal weight, without reading a likelihood. Between this and
+    /// [`Self::weigh_proposed`] the caller may prepare the observation from where the
+    /// particles now are (a tracker bins only the part of the frame they can see). The two
+    /// give the same particles and weights as `step`, bit for bit. A proposal that reads the
+    /// observation sees `z` as it is now.
+    pub fn propose<M: Model<State = S>>(&mut self, model: &M, z: &M::Observation) {
+        let (seed, step) = (self.cfg.seed, self.steps);
+        let n = self.particles.len();
+        self.increments.resize(n, 0.0);
+        self.particles.par_iter_mut().zip(self.increments.par_iter_mut()).enumerate().for_each(|(i, (p, inc))| {
+            let mut rng = stream(seed, step, i as u64);
+            let d = model.propose(p, z, &mut rng);
+            *inc = d.log_prior_over_proposal;
+            *p = d.state;
+        });
+        self.proposed = true;
+    }
+
+    /// The second half of [`Self::step`]: weighs the particles moved by [`Self::propose`]
+    /// by the observation `z`, normalizes and resamples. An error when nothing was proposed
+    /// since the last step.
+    pub fn weigh_proposed<M: Model<State = S>>(&mut self, model: &M, z: &M::Observation) -> Result<StepReport> {
+        if !self.proposed || self.increments.len() != self.particles.len() {
+            return Err(EstimationError::InvalidInput("weigh_proposed without propose".into()));
+        }
+        self.proposed = false;
+        self.particles.par_iter().zip(self.increments.par_iter_mut()).for_each(|(p, inc)| {
+            *inc += model.log_likelihood(p, z);
+        });
+        self.steps += 1;
+        self.weigh()
+    }
+
     /// One step: propose every particle, weight it by the observation `z`, normalize, and
     /// resample when the ESS falls below the configured share. When every particle is
     /// impossible (all log likelihoods `-inf`), the weights are left equal and the report's
@@ -204,6 +241,7 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
             *inc = model.log_likelihood(&d.state, z) + d.log_prior_over_proposal;
             *p = d.state;
         });
+        self.proposed = false;
         self.steps += 1;
         self.weigh()
     }
@@ -296,6 +334,24 @@ mod tests {
         fn log_likelihood(&self, x: &f64, z: &f64) -> f64 {
             log_normal(*z, *x, self.obs_sigma)
         }
+    }
+
+    #[test]
+    fn propose_then_weigh_is_step_bit_for_bit() {
+        let model = Walk { step_sigma: 0.3, obs_sigma: 0.2, pull: 0.4 };
+        let start: Vec<f64> = (0..257).map(|i| i as f64 * 0.01).collect();
+        let cfg = FilterConfig { resample_below: 0.7, ..FilterConfig::default() };
+        let mut a = ParticleFilter::new(cfg, start.clone()).unwrap();
+        let mut b = ParticleFilter::new(cfg, start).unwrap();
+        for (t, z) in [0.5, 0.8, 1.7, 1.2, 0.9].iter().enumerate() {
+            let ra = a.step(&model, z).unwrap();
+            b.propose(&model, z);
+            let rb = b.weigh_proposed(&model, z).unwrap();
+            assert_eq!(ra, rb, "step {t}");
+            assert_eq!(a.particles(), b.particles());
+            assert_eq!(a.log_weights(), b.log_weights());
+        }
+        assert!(b.weigh_proposed(&model, &0.0).is_err(), "weighing twice");
     }
 
     #[test]

@@ -16,6 +16,7 @@ use ocellus_geometry::camera::PinholeCamera;
 use ocellus_geometry::distortion::Distortion;
 use ocellus_geometry::sphere::project_sphere;
 use ocellus_image::rng::SplitMix64;
+use rayon::prelude::*;
 
 /// A ball hypothesis: centre and velocity in the world frame.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -124,6 +125,25 @@ impl BallModel {
     }
 }
 
+impl BallModel {
+    /// The pixel rectangle [x0, y0, x1, y1) that holds every likelihood sample of every
+    /// state's image circle in a `w` x `h` frame: binning only it
+    /// ([`BinnedFrame::update_region`]) gives the same scores as binning the frame. Empty
+    /// when no state is in view.
+    pub fn samples_region(&self, states: &[BallState], w: usize, h: usize) -> [usize; 4] {
+        let union = |a: [usize; 4], b: [usize; 4]| {
+            if a[0] >= a[2] || a[1] >= a[3] {
+                b
+            } else if b[0] >= b[2] || b[1] >= b[3] {
+                a
+            } else {
+                [a[0].min(b[0]), a[1].min(b[1]), a[2].max(b[2]), a[3].max(b[3])]
+            }
+        };
+        states.par_iter().map(|s| self.circle(s).map_or([0; 4], |c| c.samples_rect(w, h))).reduce(|| [0; 4], union)
+    }
+}
+
 impl Model for BallModel {
     type State = BallState;
     type Observation = BallFrame;
@@ -162,5 +182,62 @@ impl Model for BallModel {
             Some(c) => self.colour.log_likelihood(&frame.binned, c),
             None => f64::NEG_INFINITY,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::motion::MotionModel;
+    use nalgebra::Matrix3;
+    use ocellus_geometry::camera::Intrinsics;
+    use ocellus_image::Plane;
+
+    #[test]
+    fn binning_only_the_particles_region_gives_the_scores_of_the_whole_frame() {
+        let photo = ocellus_io::read_image(ocellus_testdata::asset("chelsea.png")).unwrap().to_u8();
+        let (w, h) = photo.size();
+        let k = Intrinsics { fx: 500.0, fy: 500.0, cx: w as f64 / 2.0, cy: h as f64 / 2.0, skew: 0.0 };
+        let camera = PinholeCamera { k, r: Matrix3::identity(), t: Vector3::zeros() };
+        let distortion = Distortion { k1: -0.1, k2: 0.01, k3: 0.0, p1: 0.0, p2: 0.0 };
+        let ball = Vector3::new(0.1, 0.05, 1.5);
+        let c = project_ball(&camera, &distortion, &ball, 0.05).unwrap();
+        let frame = Plane::from_fn(w, h, |x, y| {
+            if (x as f64 - c.x).powi(2) + (y as f64 - c.y).powi(2) <= c.r * c.r {
+                [240, 110, 30]
+            } else {
+                photo.get(x, y)
+            }
+        });
+        let model = BallModel {
+            camera,
+            distortion,
+            radius_m: 0.05,
+            motion: MotionModel::at_fps(30.0),
+            colour: ColourModel::from_colour([240, 110, 30]),
+            boost: 0.0,
+            detection_velocity_sigma_mps: [3.0, 0.5],
+        };
+        let mut rng = SplitMix64::new(3);
+        // A cloud about the ball, some of it reaching past the frame's edges.
+        let states: Vec<BallState> = (0..500)
+            .map(|i| {
+                let s = if i % 50 == 0 { 0.8 } else { 0.05 };
+                BallState {
+                    position: [ball.x + s * rng.normal(), ball.y + s * rng.normal(), ball.z + 0.2 * rng.normal()],
+                    velocity: [0.0; 3],
+                }
+            })
+            .collect();
+        let full = BallFrame { binned: BinnedFrame::new(&frame), detections: Vec::new() };
+        let region = model.samples_region(&states, w, h);
+        assert!((region[2] - region[0]) * (region[3] - region[1]) < w * h, "{region:?}");
+        let mut part = BallFrame::default();
+        part.binned.update_region(&frame, region);
+        for s in &states {
+            let (a, b) = (model.log_likelihood(s, &full), model.log_likelihood(s, &part));
+            assert_eq!(a.to_bits(), b.to_bits(), "{s:?}");
+        }
+        assert_eq!(model.samples_region(&[], w, h), [0; 4]);
     }
 }

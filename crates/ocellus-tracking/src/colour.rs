@@ -106,13 +106,18 @@ fn bin_block(src: &[[u8; 3]], dst: &mut [u8]) {
     dst.copy_from_slice(&out);
 }
 
-/// Bins every pixel of `frame` into `out` (same size). `M` only selects the build (the
-/// kernel has no multiply-add); [`ocellus_image::dispatch_kernel!`] compiles it with AVX2.
+/// Bins the pixels of `frame` in columns `x0..x1` of rows `y0..y1` into `out` (same size as
+/// the frame; the caller clamps the rectangle to it). `M` only selects the build (the kernel
+/// has no multiply-add); [`ocellus_image::dispatch_kernel!`] compiles it with AVX2.
 #[allow(clippy::extra_unused_type_parameters)]
 #[inline(always)]
-fn bin_plane_generic<M: ocellus_image::simd::Madd>(frame: &Plane<[u8; 3]>, out: &mut Plane<u8>) {
-    for y in 0..frame.height() {
-        let (src, dst) = (frame.row(y), out.row_mut(y));
+fn bin_rect_generic<M: ocellus_image::simd::Madd>(
+    frame: &Plane<[u8; 3]>,
+    out: &mut Plane<u8>,
+    [x0, y0, x1, y1]: [usize; 4],
+) {
+    for y in y0..y1 {
+        let (src, dst) = (&frame.row(y)[x0..x1], &mut out.row_mut(y)[x0..x1]);
         let n = src.len() / BIN_BLOCK * BIN_BLOCK;
         for (s, d) in src[..n].chunks_exact(BIN_BLOCK).zip(dst[..n].chunks_exact_mut(BIN_BLOCK)) {
             bin_block(s, d);
@@ -124,8 +129,9 @@ fn bin_plane_generic<M: ocellus_image::simd::Madd>(frame: &Plane<[u8; 3]>, out: 
 }
 
 ocellus_image::dispatch_kernel!(
-    /// Bins every pixel of a frame (the caller sizes `out`), with the backend's kernel.
-    fn bin_plane => bin_plane_generic(frame: &Plane<[u8; 3]>, out: &mut Plane<u8>)
+    /// Bins a rectangle of a frame (the caller sizes `out` and clamps the rectangle), with
+    /// the backend's kernel.
+    fn bin_rect => bin_rect_generic(frame: &Plane<[u8; 3]>, out: &mut Plane<u8>, rect: [usize; 4])
 );
 
 /// An image circle: centre (x, y) and radius, pixels.
@@ -139,10 +145,13 @@ pub struct Circle {
     pub r: f64,
 }
 
-/// A frame's pixels as histogram bins, computed once per frame.
+/// A frame's pixels as histogram bins, computed once per frame: the whole frame, or only the
+/// region a set of hypotheses can read ([`BinnedFrame::update_region`]).
 #[derive(Clone, Debug, Default)]
 pub struct BinnedFrame {
     bins: Plane<u8>,
+    /// The binned rectangle [x0, y0, x1, y1) (x1, y1 exclusive).
+    region: [usize; 4],
 }
 
 impl BinnedFrame {
@@ -162,25 +171,67 @@ impl BinnedFrame {
     /// [`Self::update`] with a chosen backend (all give the same bins).
     pub fn update_with(&mut self, backend: Backend, frame: &Plane<[u8; 3]>) {
         let (w, h) = frame.size();
-        self.bins.resize(w, h);
-        bin_plane(backend, frame, &mut self.bins);
+        self.update_region_with(backend, frame, [0, 0, w, h]);
     }
 
-    /// The bins, one per pixel.
+    /// Bins only the pixels of `frame` in the rectangle [x0, y0, x1, y1) (clamped to the
+    /// frame): a filter whose hypotheses all lie there pays for their region, not the frame.
+    /// Scores read the rest of the frame as missing, like pixels off the frame, so the
+    /// region must hold every sample of every circle scored (see [`Circle::reach`]).
+    pub fn update_region(&mut self, frame: &Plane<[u8; 3]>, region: [usize; 4]) {
+        self.update_region_with(Backend::Auto, frame, region);
+    }
+
+    /// [`Self::update_region`] with a chosen backend.
+    pub fn update_region_with(&mut self, backend: Backend, frame: &Plane<[u8; 3]>, [x0, y0, x1, y1]: [usize; 4]) {
+        let (w, h) = frame.size();
+        self.bins.resize(w, h);
+        let (x1, y1) = (x1.min(w), y1.min(h));
+        let region = [x0.min(x1), y0.min(y1), x1, y1];
+        bin_rect(backend, frame, &mut self.bins, region);
+        self.region = region;
+    }
+
+    /// The bins, one per pixel; valid inside [`Self::region`] only.
     pub fn bins(&self) -> &Plane<u8> {
         &self.bins
     }
 
-    /// The bin at the pixel nearest to (x, y), `None` outside the frame.
+    /// The binned rectangle [x0, y0, x1, y1), pixels (x1, y1 exclusive).
+    pub fn region(&self) -> [usize; 4] {
+        self.region
+    }
+
+    /// The bin at the pixel nearest to (x, y), `None` outside the binned region.
     #[inline]
     fn at(&self, x: f64, y: f64) -> Option<u8> {
         let (xi, yi) = (nearest(x), nearest(y));
-        let (w, h) = self.bins.size();
-        if xi >= 0 && yi >= 0 && (xi as usize) < w && (yi as usize) < h {
+        let [x0, y0, x1, y1] = self.region;
+        if xi >= x0 as i64 && yi >= y0 as i64 && xi < x1 as i64 && yi < y1 as i64 {
             Some(self.bins.get(xi as usize, yi as usize))
         } else {
             None
         }
+    }
+}
+
+impl Circle {
+    /// How far from the centre the likelihood's samples reach, pixels (the outer ring's
+    /// radius plus one pixel of rounding).
+    pub fn reach(&self) -> f64 {
+        self.r * RING.1 + 1.0
+    }
+
+    /// The pixel rectangle [x0, y0, x1, y1) that holds every sample of this circle, clamped
+    /// to a `w` x `h` frame (empty when the circle lies off it or is not finite).
+    pub fn samples_rect(&self, w: usize, h: usize) -> [usize; 4] {
+        let reach = self.reach();
+        if !(self.x.is_finite() && self.y.is_finite() && reach.is_finite()) {
+            return [0, 0, 0, 0];
+        }
+        let lo = |v: f64, n: usize| (v - reach).floor().clamp(0.0, n as f64) as usize;
+        let hi = |v: f64, n: usize| ((v + reach).ceil() + 1.0).clamp(0.0, n as f64) as usize;
+        [lo(self.x, w), lo(self.y, h), hi(self.x, w), hi(self.y, h)]
     }
 }
 
@@ -312,9 +363,9 @@ impl ColourModel {
         let mut inner = [0u8; SAMPLES];
         let mut ni_on = 0usize;
         let mut no = 0u32;
-        let (w, h) = frame.bins.size();
-        let reach = r * RING.1 + 1.0;
-        if x >= reach && y >= reach && x + reach < w as f64 && y + reach < h as f64 {
+        let [x0, y0, x1, y1] = frame.region.map(|v| v as f64);
+        let reach = circle.reach();
+        if x - reach >= x0 && y - reach >= y0 && x + reach < x1 && y + reach < y1 {
             // The whole pattern lies on the frame: no per-sample bounds test, and the pixel
             // indices are computed in one loop the compiler vectorizes.
             let (data, stride) = (frame.bins.as_slice(), frame.bins.stride() as i64);

@@ -175,64 +175,53 @@ impl BallTracker {
         &self.obs.detections
     }
 
-    /// Takes one frame: bins it, detects blobs, then starts the filter from the best
-    /// detection or steps it.
+    /// Takes one frame. The boosted filter, and any filter before it starts, bins the whole
+    /// frame, detects blobs, then starts from the best detection or steps. The plain filter
+    /// (`boost = 0`) once started moves its particles first and bins only the region their
+    /// circles (and their mean's) can read, skipping detection: the same estimates for a
+    /// fraction of the binning (`detections` is then 0).
     pub fn process(&mut self, frame: &Plane<[u8; 3]>) -> Result<TrackEstimate> {
         let k = self.frame;
         self.frame += 1;
-        self.obs.binned.update(frame);
-        let m = &self.model;
-        self.obs.detections =
-            detect_balls(&self.obs.binned, &m.colour, &m.camera, &m.distortion, m.radius_m, &self.cfg.detector);
-        let n_det = self.obs.detections.len();
+        let (w, h) = frame.size();
+        let plain = self.model.boost == 0.0;
         let ess = match &mut self.filter {
-            Some(f) => f.step(&self.model, &self.obs)?.ess,
-            // `detect_balls` orders the detections by colour score: start from the best.
-            None => match self.obs.detections.first().copied() {
-                Some(d) => {
-                    let mut rng = SplitMix64::new(self.cfg.filter.seed ^ 0x5EED_BA11);
-                    // Position from the detection; velocity unknown: the detection draws'
-                    // spread about rest (wide across the line of sight, narrow along it).
-                    let (across, along) =
-                        (self.cfg.detector.velocity_sigma_across_mps, self.cfg.detector.velocity_sigma_along_mps);
-                    let particles: Vec<BallState> = (0..self.cfg.particles)
-                        .map(|_| BallState {
-                            position: d.sample_position(&mut rng),
-                            velocity: d.sample_velocity(&[0.0; 3], across, along, &mut rng),
-                        })
-                        .collect();
-                    let mut f = ParticleFilter::new(self.cfg.filter, particles)?;
-                    // Weigh the start by this frame: the detection's depth is rough.
-                    let w: Vec<f64> = f
-                        .particles()
-                        .iter()
-                        .map(|p| ocellus_estimation::particle_filter::Model::log_likelihood(&self.model, p, &self.obs))
-                        .collect();
-                    f.reweight(&w)?;
-                    let ess = f.ess();
-                    self.filter = Some(f);
-                    ess
-                }
-                None => {
-                    return Ok(TrackEstimate {
-                        frame: k,
-                        position: None,
-                        velocity: None,
-                        circle: None,
-                        ess: 0.0,
-                        score: -1.0,
-                        lost: true,
-                        detections: n_det,
-                    })
-                }
-            },
+            // The plain filter reads the frame only through its particles' circles: the
+            // particles move first, and only the part of the frame they can see is binned
+            // (their scores are those of the whole frame binned); detection is skipped.
+            Some(f) if plain => {
+                self.obs.detections.clear();
+                f.propose(&self.model, &self.obs);
+                let region = self.model.samples_region(f.particles(), w, h);
+                self.obs.binned.update_region(frame, region);
+                f.weigh_proposed(&self.model, &self.obs)?.ess
+            }
+            _ => self.detect_and_step(frame)?,
         };
+        let n_det = self.obs.detections.len();
         let Some(f) = &self.filter else {
-            return Err(TrackingError::Invalid("the filter did not start".into()));
+            return Ok(TrackEstimate {
+                frame: k,
+                position: None,
+                velocity: None,
+                circle: None,
+                ess: 0.0,
+                score: -1.0,
+                lost: true,
+                detections: n_det,
+            });
         };
         let position = f.mean(|s| s.position);
         let velocity = f.mean(|s| s.velocity);
         let circle = self.model.circle(&BallState { position, velocity });
+        if let Some(c) = circle {
+            // The mean's circle may reach past the particles' region: bin what it adds.
+            let [a, b] = [self.obs.binned.region(), c.samples_rect(w, h)];
+            if b[0] < b[2] && b[1] < b[3] && (b[0] < a[0] || b[1] < a[1] || b[2] > a[2] || b[3] > a[3]) {
+                let union = [a[0].min(b[0]), a[1].min(b[1]), a[2].max(b[2]), a[3].max(b[3])];
+                self.obs.binned.update_region(frame, union);
+            }
+        }
         let score = circle.map_or(-1.0, |c| self.model.colour.score(&self.obs.binned, c));
         Ok(TrackEstimate {
             frame: k,
@@ -244,5 +233,43 @@ impl BallTracker {
             lost: score < self.cfg.lost_score,
             detections: n_det,
         })
+    }
+
+    /// Bins the whole frame, detects the balls, and steps the filter (boosted by the
+    /// detections), or starts it from the best detection; returns the ESS (0 while no ball
+    /// was ever detected).
+    fn detect_and_step(&mut self, frame: &Plane<[u8; 3]>) -> Result<f64> {
+        self.obs.binned.update(frame);
+        let m = &self.model;
+        self.obs.detections =
+            detect_balls(&self.obs.binned, &m.colour, &m.camera, &m.distortion, m.radius_m, &self.cfg.detector);
+        if let Some(f) = &mut self.filter {
+            return Ok(f.step(&self.model, &self.obs)?.ess);
+        }
+        // `detect_balls` orders the detections by colour score: start from the best.
+        let Some(d) = self.obs.detections.first().copied() else {
+            return Ok(0.0);
+        };
+        let mut rng = SplitMix64::new(self.cfg.filter.seed ^ 0x5EED_BA11);
+        // Position from the detection; velocity unknown: the detection draws' spread about
+        // rest (wide across the line of sight, narrow along it).
+        let (across, along) = (self.cfg.detector.velocity_sigma_across_mps, self.cfg.detector.velocity_sigma_along_mps);
+        let particles: Vec<BallState> = (0..self.cfg.particles)
+            .map(|_| BallState {
+                position: d.sample_position(&mut rng),
+                velocity: d.sample_velocity(&[0.0; 3], across, along, &mut rng),
+            })
+            .collect();
+        let mut f = ParticleFilter::new(self.cfg.filter, particles)?;
+        // Weigh the start by this frame: the detection's depth is rough.
+        let w: Vec<f64> = f
+            .particles()
+            .iter()
+            .map(|p| ocellus_estimation::particle_filter::Model::log_likelihood(&self.model, p, &self.obs))
+            .collect();
+        f.reweight(&w)?;
+        let ess = f.ess();
+        self.filter = Some(f);
+        Ok(ess)
     }
 }

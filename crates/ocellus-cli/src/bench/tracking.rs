@@ -1,5 +1,6 @@
-//! `ocellus bench tracking`: one SIR step of the 3D ball tracker on a 640x480 frame (binning
-//! the frame, proposing and weighing every particle by the colour likelihood, resampling) for
+//! `ocellus bench tracking`: one SIR step of the 3D ball tracker on a 640x480 frame (moving
+//! the particles, binning the region their circles read, weighing every particle by the
+//! colour likelihood, resampling; and once with the whole frame binned first) for
 //! 10^2..10^5 particles on one thread and on all, and resampling 10^6 particles with each
 //! scheme.
 
@@ -47,13 +48,16 @@ fn scene() -> Result<(Plane<[u8; 3]>, BallModel, Vector3<f64>)> {
     Ok((frame, model, ball))
 }
 
-/// Median milliseconds of one SIR step (binning included) with `n` particles on `threads`.
+/// Median milliseconds of one SIR step (binning included) with `n` particles on `threads`:
+/// as the plain tracker does it (particles moved first, then only the region their circles
+/// read is binned), or with the whole frame binned first (`whole_frame`).
 fn sir_step_ms(
     n: usize,
     threads: usize,
     frame: &Plane<[u8; 3]>,
     model: &BallModel,
     ball: &Vector3<f64>,
+    whole_frame: bool,
 ) -> Result<f64> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
     pool.install(|| -> Result<f64> {
@@ -71,8 +75,16 @@ fn sir_step_ms(
         let mut t = Vec::with_capacity(reps);
         for _ in 0..reps {
             let s = Instant::now();
-            obs.binned.update(frame);
-            pf.step(model, &obs)?;
+            if whole_frame {
+                obs.binned.update(frame);
+                pf.step(model, &obs)?;
+            } else {
+                pf.propose(model, &obs);
+                let (w, h) = frame.size();
+                let region = model.samples_region(pf.particles(), w, h);
+                obs.binned.update_region(frame, region);
+                pf.weigh_proposed(model, &obs)?;
+            }
             t.push(s.elapsed().as_secs_f64() * 1e3);
         }
         Ok(median(&mut t))
@@ -102,10 +114,14 @@ pub fn run(json_out: bool) -> Result<()> {
         .collect();
     figures.insert("ms_bin_frame_640x480".into(), json!(median(&mut tb)));
     for (p, key) in [(100, "1e2"), (1000, "1e3"), (10_000, "1e4"), (100_000, "1e5")] {
-        figures.insert(format!("ms_sir_step_{key}_1thread"), json!(sir_step_ms(p, 1, &frame, &model, &ball)?));
+        figures.insert(format!("ms_sir_step_{key}_1thread"), json!(sir_step_ms(p, 1, &frame, &model, &ball, false)?));
     }
-    let one = sir_step_ms(10_000, 1, &frame, &model, &ball)?;
-    let all = sir_step_ms(10_000, threads, &frame, &model, &ball)?;
+    figures.insert(
+        "ms_sir_step_1e3_whole_frame_1thread".into(),
+        json!(sir_step_ms(1000, 1, &frame, &model, &ball, true)?),
+    );
+    let one = sir_step_ms(10_000, 1, &frame, &model, &ball, false)?;
+    let all = sir_step_ms(10_000, threads, &frame, &model, &ball, false)?;
     figures.insert("ms_sir_step_1e4_all_threads".into(), json!(all));
     figures.insert("speedup_all_threads_1e4".into(), json!(one / all));
     figures.insert("particles_resampled".into(), json!(n));
@@ -130,12 +146,16 @@ pub fn run(json_out: bool) -> Result<()> {
         return Ok(());
     }
     outln!(
-        "one SIR step of the ball tracker on a 640x480 frame (binning {:.2} ms), one thread:",
+        "one SIR step of the ball tracker on a 640x480 frame, binning the particles' region (the whole frame: {:.2} ms), one thread:",
         v["ms_bin_frame_640x480"].as_f64().unwrap_or(0.0)
     );
     for key in ["1e2", "1e3", "1e4", "1e5"] {
         outln!("  {key:>4} particles  {:.3} ms", v[format!("ms_sir_step_{key}_1thread")].as_f64().unwrap_or(0.0));
     }
+    outln!(
+        "   1e3 particles, the whole frame binned first: {:.3} ms",
+        v["ms_sir_step_1e3_whole_frame_1thread"].as_f64().unwrap_or(0.0)
+    );
     outln!(
         "  1e4 particles on {threads} threads: {:.3} ms ({:.2}x)",
         v["ms_sir_step_1e4_all_threads"].as_f64().unwrap_or(0.0),
