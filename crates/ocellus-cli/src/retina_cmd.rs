@@ -94,7 +94,8 @@ struct LearnArgs {
     /// Weight lambda of the simplicity term lambda (mean S + mean P + mean M). Range: 0..=10.
     #[arg(long, default_value_t = ocellus_retina::experiment::DEFAULT_SIMPLICITY, value_parser = ranges::within(0.0f64, 10.0))]
     simplicity: f64,
-    /// Seed of the experience and of the start.
+    /// Seed of the experience (gaze points, images, random actions) and of the start. Range:
+    /// any 64-bit unsigned integer.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Gaussian blur of the source images before sampling (the eye's optics), sigma in
