@@ -106,6 +106,10 @@ struct LearnArgs {
     /// degrees, dilations by e^0.3). Range: 0.05..=5.
     #[arg(long, default_value_t = 1.0, value_parser = ranges::within(0.05f64, 5.0))]
     action_scale: f64,
+    /// Experiment 2: weight of the motor fields' smoothness (the mean squared difference of
+    /// neighbouring motor cells) in the cost. Range: 0..=100.
+    #[arg(long, default_value_t = 0.0, value_parser = ranges::within(0.0f64, 100.0))]
+    motor_smoothness: f64,
     /// Also learn the baseline with a random fixed S (only P, and M in experiment 2); on by
     /// default, `--baseline false` skips it.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
@@ -181,6 +185,7 @@ fn learn(a: LearnArgs) -> Result<()> {
     cfg.simplicity = a.simplicity;
     cfg.blur_px = a.blur;
     cfg.action_scale = a.action_scale;
+    cfg.motor_smoothness = a.motor_smoothness;
     cfg.validate()?;
     let src = sources(a.images.as_deref())?;
     outln!(
@@ -218,7 +223,7 @@ fn learn(a: LearnArgs) -> Result<()> {
         window: 50,
         learning_rate: a.learning_rate,
     };
-    let obj = Objective { data: &su.train, free: cfg.free(), simplicity: cfg.simplicity };
+    let obj = Objective { data: &su.train, free: cfg.free(), simplicity: cfg.simplicity, smoothness: cfg.smoothness() };
     let methods: Vec<Method> = match a.solver {
         SolverArg::Auto if cfg.experiment == 2 => vec![Method::Adam],
         SolverArg::Auto | SolverArg::Pgd => vec![Method::Pgd],
@@ -251,17 +256,17 @@ fn learn(a: LearnArgs) -> Result<()> {
     let final_cost = |r: &Run| r.state.history.last().map_or(f64::INFINITY, |h| h.cost);
     let best = (0..runs.len()).min_by(|&a, &b| final_cost(&runs[a]).total_cmp(&final_cost(&runs[b]))).unwrap_or(0);
     let main = &runs[best];
-    let held = Objective { data: &su.heldout, free: cfg.free(), simplicity: 0.0 };
+    let held = Objective { data: &su.heldout, free: cfg.free(), simplicity: 0.0, smoothness: None };
     let mse_learned = held.evaluate(&main.params, false).mse;
     let mse_identity = su.heldout.identity_mse();
     let baseline = if a.baseline {
         let mut p = start(&su, Init::Uniform, a.seed ^ 0xBA5E)?;
         let free = Free { s: false, ..cfg.free() };
-        let bobj = Objective { data: &su.train, free, simplicity: cfg.simplicity };
+        let bobj = Objective { data: &su.train, free, simplicity: cfg.simplicity, smoothness: cfg.smoothness() };
         let mut st = SolverState::new();
         let stop =
             run_solver(&bobj, &scfg(main.method), &mut p, &mut st, None, &cfg, a.checkpoint_every, "random S: ")?;
-        let mse = Objective { data: &su.heldout, free, simplicity: 0.0 }.evaluate(&p, false).mse;
+        let mse = Objective { data: &su.heldout, free, simplicity: 0.0, smoothness: None }.evaluate(&p, false).mse;
         Some((mse, stop, st))
     } else {
         None

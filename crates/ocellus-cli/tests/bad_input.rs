@@ -175,6 +175,7 @@ const CASES: &[Case] = &[
     c("retina learn --experiment 1 --learning-rate NaN --out {O}", Usage(&["--learning-rate", "range"])),
     c("retina learn --experiment 1 --simplicity -1 --out {O}", Usage(&["--simplicity", "range"])),
     c("retina learn --experiment 1 --blur inf --out {O}", Usage(&["--blur", "range"])),
+    c("retina learn --experiment 2 --motor-smoothness NaN --out {O}", Usage(&["--motor-smoothness", "range"])),
     c("retina learn --experiment 2 --actions all --out {O}", Error(&["2D motor space"])),
     c("retina learn --experiment 2 --small --out {O}", Error(&["--small"])),
     c("retina learn --experiment 1 --small --resume --out {O}", Error(&["no checkpoint"])),

@@ -19,7 +19,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let cfg = ExperimentConfig::sensor_design_small(actions);
         let su = setup::<f32>(&cfg, &sources)?;
         let mut p = start(&su, Init::Blobs, cfg.seed)?;
-        let obj = Objective { data: &su.train, free: cfg.free(), simplicity: cfg.simplicity };
+        let obj = Objective { data: &su.train, free: cfg.free(), simplicity: cfg.simplicity, smoothness: None };
         let mut state = SolverState::new();
         let stop = solve(&obj, &SolverConfig::default(), &mut p, &mut state, |_, _| true)?;
         let layout = measure(&su.disc, &p.s, cfg.fields)?;

@@ -48,6 +48,9 @@ pub struct ExperimentConfig {
     /// Factor on the default largest actions of [`ActionRanges::for_radius`] (shift r / 2,
     /// rotation 30 degrees, log-scale 0.3).
     pub action_scale: f64,
+    /// Experiment 2: weight of the motor fields' smoothness over the motor grid (see
+    /// [`crate::model::Objective::smoothness`]); 0 for none.
+    pub motor_smoothness: f64,
 }
 
 impl ExperimentConfig {
@@ -66,6 +69,7 @@ impl ExperimentConfig {
             seed: 1,
             blur_px: DEFAULT_BLUR_PX,
             action_scale: 1.0,
+            motor_smoothness: 0.0,
         }
     }
 
@@ -84,6 +88,7 @@ impl ExperimentConfig {
             seed: 1,
             blur_px: DEFAULT_BLUR_PX,
             action_scale: 1.0,
+            motor_smoothness: 0.0,
         }
     }
 
@@ -118,6 +123,12 @@ impl ExperimentConfig {
         if !(self.action_scale.is_finite() && self.action_scale > 0.0 && self.action_scale <= 5.0) {
             return Err(RetinaError::Invalid(format!("action scale {} must lie in (0, 5]", self.action_scale)));
         }
+        if !(self.motor_smoothness.is_finite() && self.motor_smoothness >= 0.0) {
+            return Err(RetinaError::Invalid(format!(
+                "motor smoothness {} must be finite and >= 0",
+                self.motor_smoothness
+            )));
+        }
         if !(self.blur_px.is_finite() && (0.0..=50.0).contains(&self.blur_px)) {
             return Err(RetinaError::Invalid(format!("blur sigma {} px must lie in [0, 50]", self.blur_px)));
         }
@@ -133,6 +144,12 @@ impl ExperimentConfig {
     /// Which blocks are learned.
     pub fn free(&self) -> Free {
         Free { s: true, m: self.experiment == 2, p: true }
+    }
+
+    /// The smoothness term of the objective (experiment 2 with a positive weight).
+    pub fn smoothness(&self) -> Option<crate::model::MotorSmoothness> {
+        (self.experiment == 2 && self.motor_smoothness > 0.0)
+            .then_some(crate::model::MotorSmoothness { cells: self.grid_cells, weight: self.motor_smoothness })
     }
 
     /// The number of learned variables.
@@ -214,7 +231,8 @@ pub enum Init {
     /// fields would tile the disc, independently of the centre (so the start has no relation
     /// of size to eccentricity, no fovea, by construction), plus a floor of 1 % noise; each
     /// row sums to 1. The predictors start near "nothing changes" (P_k = I plus 10 % noise)
-    /// and the motor fields (when learned) uniform random. The default: it skips the slow
+    /// and learned motor fields as bumps at random cells of the motor grid, width about the
+    /// grid over the square root of their number, +-50 %. The default: it skips the slow
     /// symmetry breaking of `Uniform`.
     Blobs,
 }
@@ -266,6 +284,25 @@ pub fn start<T: Real>(setup: &Setup<T>, init: Init, seed: u64) -> Result<Params<
                 for b in 0..r {
                     let v = if a == b { 1.0 } else { 0.0 } + 0.1 * rng.unit();
                     p.p[(k * r + a) * r + b] = T::from_f64(v);
+                }
+            }
+        }
+        if c.experiment == 2 {
+            // Learned motor fields start as bumps too, at random cells of the motor grid:
+            // from uniform or uniform random fields, every action mixes the same predictors,
+            // their gradients agree, and the fields never specialize (tried: they stay noise,
+            // or turn flat under a smoothness term).
+            let n = c.grid_cells;
+            let width = n as f64 / (shape.motor_fields as f64).sqrt();
+            for k in 0..shape.motor_fields {
+                let (cx, cy) = (rng.unit() * (n - 1) as f64, rng.unit() * (n - 1) as f64);
+                let w = width * (0.5 + rng.unit());
+                for y in 0..n {
+                    for x in 0..n {
+                        let d2 = (x as f64 - cx).powi(2) + (y as f64 - cy).powi(2);
+                        let v = (-d2 / (2.0 * w * w)).exp() + 0.01 * rng.unit();
+                        p.m[k * n * n + y * n + x] = T::from_f64(v);
+                    }
                 }
             }
         }

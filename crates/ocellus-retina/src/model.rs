@@ -180,6 +180,20 @@ pub struct Objective<'a, T> {
     pub free: Free,
     /// Weight lambda of the simplicity term (>= 0).
     pub simplicity: f64,
+    /// Smoothness of learned motor fields over a `cells` x `cells` motor grid: weight mu of
+    /// the mean squared difference between 4-neighbouring cells of every motor field, added
+    /// to the cost. Neighbouring cells code similar actions, but each sees only its own
+    /// triplets; without it the learned fields stay as noisy as the start.
+    pub smoothness: Option<MotorSmoothness>,
+}
+
+/// See [`Objective::smoothness`].
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MotorSmoothness {
+    /// Cells per axis of the motor grid (cells^2 = motor cells).
+    pub cells: usize,
+    /// Weight mu (>= 0).
+    pub weight: f64,
 }
 
 /// What one evaluation gives.
@@ -213,6 +227,14 @@ impl<'a, T: Real> Objective<'a, T> {
         if !(self.simplicity.is_finite() && self.simplicity >= 0.0) {
             return Err(RetinaError::Invalid(format!("simplicity weight {} must be finite and >= 0", self.simplicity)));
         }
+        if let Some(m) = self.smoothness {
+            if m.cells < 2 || m.cells * m.cells != sh.motor_cells || !(m.weight.is_finite() && m.weight >= 0.0) {
+                return Err(RetinaError::Invalid(format!(
+                    "motor smoothness over {0}x{0} cells with weight {1} does not fit {2} motor cells",
+                    m.cells, m.weight, sh.motor_cells
+                )));
+            }
+        }
         self.data.validate()
     }
 
@@ -235,6 +257,37 @@ impl<'a, T: Real> Objective<'a, T> {
                 cost += self.simplicity * sum / sizes[b] as f64;
             }
         }
+        // The smoothness of the motor fields: mu times the mean squared difference of
+        // 4-neighbouring cells, and its gradient.
+        let mut smooth_grad = Vec::new();
+        if let (Some(ms), true) = (self.smoothness, free[1]) {
+            let (n, q) = (ms.cells, params.shape.motor_cells);
+            let pairs = (params.shape.motor_fields * 2 * n * (n - 1)) as f64;
+            let scale = ms.weight / pairs;
+            if grad {
+                smooth_grad = vec![0.0f64; params.m.len()];
+            }
+            let mut sum = 0.0;
+            for k in 0..params.shape.motor_fields {
+                let row = &params.m[k * q..(k + 1) * q];
+                for y in 0..n {
+                    for x in 0..n {
+                        let here = row[y * n + x].to_f64();
+                        for (nx, ny) in [(x + 1, y), (x, y + 1)] {
+                            if nx < n && ny < n {
+                                let d = here - row[ny * n + nx].to_f64();
+                                sum += d * d;
+                                if grad {
+                                    smooth_grad[k * q + y * n + x] += 2.0 * scale * d;
+                                    smooth_grad[k * q + ny * n + nx] -= 2.0 * scale * d;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            cost += scale * sum;
+        }
         let grad = grad.then(|| {
             let mut g = Params::zeros(params.shape);
             for part in chunks.iter().filter_map(|c| c.grad.as_ref()) {
@@ -250,6 +303,9 @@ impl<'a, T: Real> Objective<'a, T> {
                 } else {
                     dst.iter_mut().for_each(|d| *d = T::default());
                 }
+            }
+            for (d, &v) in g.m.iter_mut().zip(&smooth_grad) {
+                *d += T::from_f64(v);
             }
             g
         });
@@ -403,7 +459,7 @@ fn chunk<T: Real>(data: &Experience<T>, p: &Params<T>, r0: usize, r1: usize, gra
 /// (one factor for all of P; the prediction is linear in P). Leaves P alone when the
 /// predictions are all zero.
 pub fn fit_scale<T: Real>(data: &Experience<T>, params: &mut Params<T>) {
-    let obj = Objective { data, free: Free { s: false, m: false, p: false }, simplicity: 0.0 };
+    let obj = Objective { data, free: Free { s: false, m: false, p: false }, simplicity: 0.0, smoothness: None };
     let pred = obj.predict(params);
     let (mut pp, mut py) = (0.0, 0.0);
     for (a, b) in pred.iter().zip(&data.x1) {
@@ -423,7 +479,7 @@ mod tests {
 
     /// A small random problem in f64: `t` triplets, dense or one-hot motor codes.
     fn problem(t: usize, one_hot: bool, seed: u64) -> (Experience<f64>, Params<f64>) {
-        let shape = Shape { pixels: 13, fields: 4, motor_fields: 3, motor_cells: if one_hot { 3 } else { 5 } };
+        let shape = Shape { pixels: 13, fields: 4, motor_fields: 3, motor_cells: if one_hot { 3 } else { 4 } };
         let mut rng = SplitMix64::new(seed);
         let mut data = Experience {
             pixels: 13,
@@ -437,8 +493,8 @@ mod tests {
             if one_hot {
                 data.q[i * 3 + rng.below(3)] = 1.0;
             } else {
-                for j in 0..5 {
-                    data.q[i * 5 + j] = rng.unit();
+                for j in 0..4 {
+                    data.q[i * 4 + j] = rng.unit();
                 }
             }
         }
@@ -471,7 +527,12 @@ mod tests {
         for one_hot in [false, true] {
             // More than one chunk, the last one partial.
             let (data, p) = problem(CHUNK + 37, one_hot, 4);
-            let obj = Objective { data: &data, free: Free { s: true, m: !one_hot, p: true }, simplicity: 0.0 };
+            let obj = Objective {
+                data: &data,
+                free: Free { s: true, m: !one_hot, p: true },
+                simplicity: 0.0,
+                smoothness: None,
+            };
             obj.check(&p).unwrap();
             let ev = obj.evaluate(&p, false);
             let want = direct_sse(&data, &p) / (data.len() * 13) as f64;
@@ -483,7 +544,10 @@ mod tests {
     fn the_gradient_matches_finite_differences() {
         for one_hot in [false, true] {
             let (data, p) = problem(40, one_hot, 9);
-            let obj = Objective { data: &data, free: Free { s: true, m: !one_hot, p: true }, simplicity: 0.01 };
+            // The dense codes form a 2 x 2 motor grid: the smoothness term is checked too.
+            let smoothness = (!one_hot).then_some(MotorSmoothness { cells: 2, weight: 0.5 });
+            let obj =
+                Objective { data: &data, free: Free { s: true, m: !one_hot, p: true }, simplicity: 0.01, smoothness };
             let g = obj.evaluate(&p, true).grad.unwrap();
             let mut rng = SplitMix64::new(5);
             for b in 0..3 {
@@ -510,7 +574,8 @@ mod tests {
     #[test]
     fn results_do_not_depend_on_the_thread_count() {
         let (data, p) = problem(3 * CHUNK + 5, false, 11);
-        let obj = Objective { data: &data, free: Free { s: true, m: true, p: true }, simplicity: 0.1 };
+        let obj =
+            Objective { data: &data, free: Free { s: true, m: true, p: true }, simplicity: 0.1, smoothness: None };
         let run = |threads| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| obj.evaluate(&p, true))
@@ -523,7 +588,8 @@ mod tests {
     #[test]
     fn mismatched_or_bad_parameters_are_refused() {
         let (data, mut p) = problem(10, true, 2);
-        let obj = Objective { data: &data, free: Free { s: true, m: false, p: true }, simplicity: 0.0 };
+        let obj =
+            Objective { data: &data, free: Free { s: true, m: false, p: true }, simplicity: 0.0, smoothness: None };
         p.s[3] = f64::NAN;
         assert!(obj.check(&p).is_err());
         p.s[3] = -1.0;

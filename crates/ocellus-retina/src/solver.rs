@@ -418,7 +418,8 @@ mod tests {
     #[test]
     fn both_solvers_lower_the_cost_and_keep_every_entry_non_negative() {
         let (data, p0) = problem();
-        let obj = Objective { data: &data, free: Free { s: true, m: false, p: true }, simplicity: 1e-3 };
+        let obj =
+            Objective { data: &data, free: Free { s: true, m: false, p: true }, simplicity: 1e-3, smoothness: None };
         for method in [Method::Pgd, Method::Adam] {
             let mut p = p0.clone();
             let cfg = SolverConfig { method, max_iterations: 200, ..SolverConfig::default() };
@@ -440,7 +441,8 @@ mod tests {
     #[test]
     fn runs_are_deterministic_and_resume_where_they_stopped() {
         let (data, p0) = problem();
-        let obj = Objective { data: &data, free: Free { s: true, m: false, p: true }, simplicity: 1e-3 };
+        let obj =
+            Objective { data: &data, free: Free { s: true, m: false, p: true }, simplicity: 1e-3, smoothness: None };
         for method in [Method::Pgd, Method::Adam] {
             let cfg = SolverConfig { method, max_iterations: 40, tolerance: 0.0, ..SolverConfig::default() };
             let mut a = p0.clone();
@@ -468,7 +470,8 @@ mod tests {
     #[test]
     fn bad_settings_are_refused() {
         let (data, mut p) = problem();
-        let obj = Objective { data: &data, free: Free { s: true, m: false, p: true }, simplicity: 0.0 };
+        let obj =
+            Objective { data: &data, free: Free { s: true, m: false, p: true }, simplicity: 0.0, smoothness: None };
         let mut st = SolverState::new();
         for cfg in [
             SolverConfig { learning_rate: f64::NAN, ..SolverConfig::default() },

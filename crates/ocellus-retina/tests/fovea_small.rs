@@ -23,10 +23,11 @@ fn run(actions: ActionKinds, seed: u64) -> (f64, f64, f64, f64) {
     let su = setup::<f32>(&cfg, &sources()).unwrap();
     let mut p = start(&su, Init::Blobs, seed).unwrap();
     let before = measure(&su.disc, &p.s, cfg.fields).unwrap().fovea_index;
-    let obj = Objective { data: &su.train, free: cfg.free(), simplicity: cfg.simplicity };
+    let obj = Objective { data: &su.train, free: cfg.free(), simplicity: cfg.simplicity, smoothness: None };
     solve(&obj, &SolverConfig::default(), &mut p, &mut SolverState::new(), |_, _| true).unwrap();
     let after = measure(&su.disc, &p.s, cfg.fields).unwrap().fovea_index;
-    let held = Objective { data: &su.heldout, free: cfg.free(), simplicity: 0.0 }.evaluate(&p, false).mse;
+    let held =
+        Objective { data: &su.heldout, free: cfg.free(), simplicity: 0.0, smoothness: None }.evaluate(&p, false).mse;
     (before, after, held, su.heldout.identity_mse())
 }
 

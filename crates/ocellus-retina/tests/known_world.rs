@@ -67,7 +67,7 @@ fn with_one_field_per_pixel_the_predictors_become_the_shift_matrices() {
     // S fixed at the identity: the problem in P is convex with the shifts as its unique
     // minimum.
     p.s = (0..N * N).map(|i| if i / N == i % N { 1.0 } else { 0.0 }).collect();
-    let obj = Objective { data: &data, free: Free { s: false, m: false, p: true }, simplicity: 0.0 };
+    let obj = Objective { data: &data, free: Free { s: false, m: false, p: true }, simplicity: 0.0, smoothness: None };
     let cfg = SolverConfig { method: Method::Pgd, max_iterations: 3000, tolerance: 1e-9, ..SolverConfig::default() };
     solve(&obj, &cfg, &mut p, &mut SolverState::new(), |_, _| true).unwrap();
     for (k, &s) in SHIFTS.iter().enumerate() {
@@ -83,7 +83,7 @@ fn learning_fields_and_predictors_together_recovers_the_shifts() {
     let data = ring_world(200, 2);
     let shape = Shape { pixels: N, fields: N, motor_fields: 2, motor_cells: 2 };
     let mut p = Params::random(shape, true, 5).unwrap();
-    let obj = Objective { data: &data, free: Free { s: true, m: false, p: true }, simplicity: 0.0 };
+    let obj = Objective { data: &data, free: Free { s: true, m: false, p: true }, simplicity: 0.0, smoothness: None };
     let cfg = SolverConfig { method: Method::Pgd, max_iterations: 20_000, tolerance: 1e-7, ..SolverConfig::default() };
     let mut st = SolverState::new();
     solve(&obj, &cfg, &mut p, &mut st, |_, _| true).unwrap();

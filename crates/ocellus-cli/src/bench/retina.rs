@@ -23,7 +23,7 @@ fn measure(cfg: &ExperimentConfig, threads: usize, iters: usize) -> Result<serde
     pool.install(|| -> Result<serde_json::Value> {
         let su = setup::<f32>(cfg, &sources)?;
         let p0 = start(&su, Init::Blobs, 1)?;
-        let obj = Objective { data: &su.train, free: cfg.free(), simplicity: cfg.simplicity };
+        let obj = Objective { data: &su.train, free: cfg.free(), simplicity: cfg.simplicity, smoothness: None };
         let mut t: Vec<f64> = (0..7)
             .map(|_| {
                 let s = Instant::now();
