@@ -194,9 +194,9 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
     /// The first half of [`Self::step`]: moves every particle by the proposal and keeps its
     /// prior-over-proposal weight, without reading a likelihood. Between this and
     /// [`Self::weigh_proposed`] the caller may prepare the observation from where the
-    /// particles now are (a tracker bins only the part of the frame they can see). The two
-    /// give the same particles and weights as `step`, bit for bit. A proposal that reads the
-    /// observation sees `z` as it is now.
+    /// particles now are (a tracker bins only the part of the frame they can see); `step`
+    /// is the two in a row. A proposal that reads the observation sees `z` as it is now.
+    /// Particles are moved in place: no allocation per step.
     pub fn propose<M: Model<State = S>>(&mut self, model: &M, z: &M::Observation) {
         let (seed, step) = (self.cfg.seed, self.steps);
         let n = self.particles.len();
@@ -231,19 +231,8 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
     /// `log_evidence` is `-inf`: the cloud follows the motion model until it finds the
     /// target again.
     pub fn step<M: Model<State = S>>(&mut self, model: &M, z: &M::Observation) -> Result<StepReport> {
-        let (seed, step) = (self.cfg.seed, self.steps);
-        let n = self.particles.len();
-        // Each particle is moved and weighed in place: no allocation per step.
-        self.increments.resize(n, 0.0);
-        self.particles.par_iter_mut().zip(self.increments.par_iter_mut()).enumerate().for_each(|(i, (p, inc))| {
-            let mut rng = stream(seed, step, i as u64);
-            let d = model.propose(p, z, &mut rng);
-            *inc = model.log_likelihood(&d.state, z) + d.log_prior_over_proposal;
-            *p = d.state;
-        });
-        self.proposed = false;
-        self.steps += 1;
-        self.weigh()
+        self.propose(model, z);
+        self.weigh_proposed(model, z)
     }
 
     /// Multiplies the weights by `exp(log_increments)` without moving the particles (e.g. to

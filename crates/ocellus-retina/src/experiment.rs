@@ -83,12 +83,7 @@ impl ExperimentConfig {
             grid_cells: 15,
             triplets: 22_500,
             heldout: 2_500,
-            actions,
-            simplicity: DEFAULT_SIMPLICITY,
-            seed: 1,
-            blur_px: DEFAULT_BLUR_PX,
-            action_scale: 1.0,
-            motor_smoothness: 0.0,
+            ..Self::sensor_design(actions)
         }
     }
 

@@ -39,6 +39,22 @@ fn disc_index(disc: &Disc) -> (usize, Vec<Option<usize>>) {
     (side, idx)
 }
 
+/// A black disc on a grey square, each pixel magnified `scale` times, and the map from a
+/// pixel offset (x right, y down from the gaze point) to the canvas.
+fn disc_canvas(disc: &Disc, scale: usize) -> (Plane<[u8; 3]>, impl Fn([f64; 2]) -> [f64; 2]) {
+    let (side, idx) = disc_index(disc);
+    let scale = scale.max(1);
+    let img = Plane::from_fn(side * scale, side * scale, |x, y| {
+        if idx[(y / scale) * side + x / scale].is_some() {
+            [0, 0, 0]
+        } else {
+            BACKGROUND
+        }
+    });
+    let (h, s) = (disc.half_width() as f64, scale as f64);
+    (img, move |v: [f64; 2]| [(v[0] + h) * s + 0.5 * (s - 1.0), (v[1] + h) * s + 0.5 * (s - 1.0)])
+}
+
 fn check_s<T>(disc: &Disc, s: &[T], fields: usize) -> Result<()> {
     if fields == 0 || s.len() != fields * disc.len() {
         return Err(RetinaError::Invalid(format!(
@@ -90,14 +106,7 @@ pub fn layout_contours<T: Real>(disc: &Disc, s: &[T], layout: &Layout, scale: us
     let n = disc.len();
     let (side, idx) = disc_index(disc);
     let scale = scale.max(1);
-    let h = disc.half_width() as f64;
-    let mut img = Plane::from_fn(side * scale, side * scale, |x, y| {
-        if idx[(y / scale) * side + x / scale].is_some() {
-            [0, 0, 0]
-        } else {
-            BACKGROUND
-        }
-    });
+    let (mut img, at) = disc_canvas(disc, scale);
     let inside = |i: usize, peak: f64, x: i64, y: i64| -> bool {
         if x < 0 || y < 0 || x >= side as i64 || y >= side as i64 {
             return false;
@@ -130,8 +139,7 @@ pub fn layout_contours<T: Real>(disc: &Disc, s: &[T], layout: &Layout, scale: us
                 }
             }
         }
-        let at = |v: f64| (v + h) * scale as f64 + 0.5 * (scale as f64 - 1.0);
-        dot(&mut img, [at(f.centre[0]), at(f.centre[1])], c);
+        dot(&mut img, at(f.centre), c);
     }
     Ok(img)
 }
@@ -181,19 +189,7 @@ pub fn predictor_flow<T: Real>(
     if p.len() != fields * fields {
         return Err(RetinaError::Invalid(format!("a predictor has {} entries, not {fields}^2", p.len())));
     }
-    let (side, idx) = disc_index(disc);
-    let scale = scale.max(1);
-    let h = disc.half_width() as f64;
-    let mut img = Plane::from_fn(side * scale, side * scale, |x, y| {
-        if idx[(y / scale) * side + x / scale].is_some() {
-            [0, 0, 0]
-        } else {
-            BACKGROUND
-        }
-    });
-    let at = |v: [f64; 2]| {
-        [(v[0] + h) * scale as f64 + 0.5 * (scale as f64 - 1.0), (v[1] + h) * scale as f64 + 0.5 * (scale as f64 - 1.0)]
-    };
+    let (mut img, at) = disc_canvas(disc, scale);
     for f in &layout.fields {
         let (mut w, mut sx, mut sy) = (0.0, 0.0, 0.0);
         for g in &layout.fields {
