@@ -29,7 +29,7 @@ fn saliency_640x480(bencher: divan::Bencher, preset: &str) {
     });
 }
 
-#[divan::bench(args = [Backend::Scalar, Backend::Avx2])]
+#[divan::bench(args = [Backend::Scalar, Backend::Avx2, Backend::Avx512])]
 fn first_pyramid_level_rgb8(bencher: divan::Bencher, backend: Backend) {
     let RgbImage::U8(p) = frame() else { return };
     let (mut a, mut b, mut c) = (Plane::default(), Plane::default(), Plane::default());
@@ -39,7 +39,7 @@ fn first_pyramid_level_rgb8(bencher: divan::Bencher, backend: Backend) {
     });
 }
 
-#[divan::bench(args = [Backend::Scalar, Backend::Avx2])]
+#[divan::bench(args = [Backend::Scalar, Backend::Avx2, Backend::Avx512])]
 fn inhibition_filter_40x30(bencher: divan::Bencher, backend: Backend) {
     let k: Vec<f32> = (-14i32..=14).map(|i| (-(i * i) as f32 / 200.0).exp()).collect();
     let mut f = PreservingFilter::new(&k, 40, 30).expect("filter");

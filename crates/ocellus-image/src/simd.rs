@@ -1,10 +1,13 @@
-//! Run-time choice between the portable and the AVX2 + FMA builds of the hot kernels.
+//! Run-time choice between the portable, AVX2 + FMA and AVX-512 builds of the hot kernels.
 //!
 //! Each hot kernel is written once as an `#[inline(always)]` function generic over [`Madd`]
-//! (how `a * b + c` is computed) and instantiated twice: a portable build (separate multiply
-//! and add) and a build inside `#[target_feature(enable = "avx2,fma")]` that uses fused
-//! multiply-adds and lets the compiler vectorize with 256-bit registers. The two agree to
-//! within float rounding (tests check 1e-5).
+//! (how `a * b + c` is computed) and instantiated three times: a portable build (separate
+//! multiply and add), a build inside `#[target_feature(enable = "avx2,fma")]` that uses fused
+//! multiply-adds and lets the compiler vectorize with 256-bit registers, and the same inside
+//! `avx512f,avx512bw,avx512vl,avx512dq` for 512-bit registers (and masked loop tails). They
+//! agree to within float rounding (tests check 1e-5). One source per kernel, compiled per
+//! width, rather than hand-written intrinsics per width: the loops are plain slices the
+//! compiler vectorizes fully, and a new width costs one line here.
 
 use serde::{Deserialize, Serialize};
 
@@ -24,14 +27,20 @@ pub enum Backend {
     /// SSE4.1 + SSSE3 (x86-64): the 128-bit integer kernels (log-polar box pyramid, SAD block
     /// search); the float kernels run their portable build.
     Sse41,
-    /// AVX2 + FMA (x86-64), which implies SSE4.1: every kernel's widest build.
+    /// AVX2 + FMA (x86-64), which implies SSE4.1: every float kernel's 256-bit build and the
+    /// hand-written AVX2 integer kernels.
     Avx2,
+    /// AVX-512 F + BW + VL + DQ (x86-64), which implies AVX2 + FMA: every float kernel
+    /// compiled for 512-bit registers; the hand-written integer kernels run their AVX2 form.
+    Avx512,
 }
 
 impl Backend {
     /// The fastest backend available on this CPU.
     pub fn detect() -> Backend {
-        if avx2_available() {
+        if avx512_available() {
+            Backend::Avx512
+        } else if avx2_available() {
             Backend::Avx2
         } else if sse41_available() {
             Backend::Sse41
@@ -41,10 +50,11 @@ impl Backend {
     }
 
     /// Turns `Auto` into a concrete backend; an unavailable one falls back to the best
-    /// available below it (`Avx2` to `Sse41` to `Scalar`).
+    /// available below it (`Avx512` to `Avx2` to `Sse41` to `Scalar`).
     pub fn resolve(self) -> Backend {
         match self {
             Backend::Auto => Backend::detect(),
+            Backend::Avx512 if !avx512_available() => Backend::Avx2.resolve(),
             Backend::Avx2 if !avx2_available() => Backend::Sse41.resolve(),
             Backend::Sse41 if !sse41_available() => Backend::Scalar,
             b => b,
@@ -60,12 +70,22 @@ impl Backend {
         if avx2_available() {
             v.push(Backend::Avx2);
         }
+        if avx512_available() {
+            v.push(Backend::Avx512);
+        }
         v
+    }
+
+    /// True when this backend resolves to one whose CPU has AVX2 + FMA (`Avx2` or `Avx512`):
+    /// the hand-written AVX2 kernels may run.
+    pub fn has_avx2(self) -> bool {
+        matches!(self.resolve(), Backend::Avx2 | Backend::Avx512)
     }
 
     /// Short name, for reports.
     pub fn name(self) -> &'static str {
         match self.resolve() {
+            Backend::Avx512 => "avx512",
             Backend::Avx2 => "avx2+fma",
             Backend::Sse41 => "sse4.1",
             _ => "scalar",
@@ -79,6 +99,23 @@ pub fn avx2_available() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") && sse41_available()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// True when the CPU has AVX-512 F, BW, VL and DQ besides AVX2 and FMA.
+#[inline]
+pub fn avx512_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        avx2_available()
+            && is_x86_feature_detected!("avx512f")
+            && is_x86_feature_detected!("avx512bw")
+            && is_x86_feature_detected!("avx512vl")
+            && is_x86_feature_detected!("avx512dq")
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
@@ -102,8 +139,9 @@ pub fn sse41_available() -> bool {
 /// How a kernel computes `a * b + c`.
 pub trait Madd {
     /// True for the flavour that [`dispatch_kernel!`] instantiates only inside functions
-    /// compiled with AVX2 and FMA: kernels may then call `#[target_feature(enable = "avx2")]`
-    /// helpers (explicit intrinsics) without a further check.
+    /// compiled with AVX2 and FMA (or AVX-512, which implies them): kernels may then call
+    /// `#[target_feature(enable = "avx2")]` helpers (explicit intrinsics) without a further
+    /// check.
     const AVX2: bool;
     /// `a * b + c`, fused or not.
     fn madd(a: f32, b: f32, c: f32) -> f32;
@@ -130,8 +168,8 @@ impl Madd for Fused {
 }
 
 /// Defines `$name(backend, args..) -> ret` that runs `$generic::<Plain>` or, on AVX2 + FMA
-/// CPUs, `$generic::<Fused>` compiled with those features enabled. Dispatch once per plane,
-/// not per row, so the whole loop nest is compiled for the chosen features.
+/// (AVX-512) CPUs, `$generic::<Fused>` compiled with those features enabled. Dispatch once
+/// per plane, not per row, so the whole loop nest is compiled for the chosen features.
 #[macro_export]
 macro_rules! dispatch_kernel {
     ($(#[$m:meta])* $vis:vis fn $name:ident => $generic:ident ( $($arg:ident : $ty:ty),* $(,)? ) $(-> $ret:ty)?) => {
@@ -144,9 +182,16 @@ macro_rules! dispatch_kernel {
                 unsafe fn avx2($($arg: $ty),*) $(-> $ret)? {
                     $generic::<$crate::simd::Fused>($($arg),*)
                 }
-                if backend.resolve() == $crate::Backend::Avx2 {
+                #[target_feature(enable = "avx2,fma,avx512f,avx512bw,avx512vl,avx512dq")]
+                unsafe fn avx512($($arg: $ty),*) $(-> $ret)? {
+                    $generic::<$crate::simd::Fused>($($arg),*)
+                }
+                match backend.resolve() {
+                    // SAFETY: resolve() returns Avx512 only when the CPU has AVX-512 F/BW/VL/DQ, AVX2 and FMA.
+                    $crate::Backend::Avx512 => return unsafe { avx512($($arg),*) },
                     // SAFETY: resolve() returns Avx2 only when the CPU supports AVX2 and FMA.
-                    return unsafe { avx2($($arg),*) };
+                    $crate::Backend::Avx2 => return unsafe { avx2($($arg),*) },
+                    _ => {}
                 }
             }
             let _ = backend;

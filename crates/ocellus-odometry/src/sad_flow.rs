@@ -297,7 +297,7 @@ fn windows_kernel(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig, n: usi
     #[cfg(target_arch = "x86_64")]
     let fast = b == 8 && span <= 16 && x0 + (n - 1) * cfg.window + 32 <= w && backend != Backend::Scalar;
     #[cfg(target_arch = "x86_64")]
-    let avx2 = fast && backend == Backend::Avx2;
+    let avx2 = fast && backend.has_avx2();
     #[cfg(not(target_arch = "x86_64"))]
     let _ = backend;
     out.clear();

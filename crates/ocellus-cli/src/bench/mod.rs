@@ -67,7 +67,7 @@ pub struct BenchArgs {
     /// Presets to measure (default: ace2009 and stb). Saliency only.
     #[arg(long, value_delimiter = ',')]
     pub preset: Vec<String>,
-    /// Kernel build: auto, scalar, sse41 or avx2 (an unavailable one falls back to the best
+    /// Kernel build: auto, scalar, sse41, avx2 or avx512 (an unavailable one falls back to the best
     /// below it) [default: auto]. Not for attention (it times the `attend` command).
     #[arg(long)]
     pub backend: Option<String>,
@@ -112,7 +112,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
     let n = a.frames.unwrap_or(300);
     let backend_name = a.backend.as_deref().unwrap_or("auto");
     let backend: Backend = serde_json::from_value(json!(backend_name))
-        .map_err(|_| anyhow::anyhow!("unknown backend '{backend_name}' (auto, scalar, sse41, avx2)"))?;
+        .map_err(|_| anyhow::anyhow!("unknown backend '{backend_name}' (auto, scalar, sse41, avx2, avx512)"))?;
     match a.target {
         Target::Attention => return attention::run(a.json, n),
         Target::Planning => return planning::run(a.json, backend, n.max(100)),

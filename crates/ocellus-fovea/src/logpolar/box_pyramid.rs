@@ -149,7 +149,7 @@ pub(super) fn sum4_rgb_row(backend: Backend, a: &[u8], b: &[u8], r: &mut [u16], 
     let n = r.len().min(g.len()).min(bl.len()).min(a.len() / 6).min(b.len() / 6);
     let mut done = 0;
     #[cfg(target_arch = "x86_64")]
-    if backend == Backend::Avx2 {
+    if backend.has_avx2() {
         // SAFETY: a resolved Avx2 means the CPU has AVX2; the kernel stays inside the slices.
         done = unsafe { sum4_rgb_row_avx2(&a[..6 * n], &b[..6 * n], &mut r[..n], &mut g[..n], &mut bl[..n]) };
     } else if backend == Backend::Sse41 {
@@ -302,7 +302,7 @@ type RowKernel<T> = unsafe fn(&[T], &[T], &mut [u16]) -> usize;
 impl SumTexel for u8 {
     fn row_kernel(backend: Backend) -> Option<RowKernel<u8>> {
         #[cfg(target_arch = "x86_64")]
-        if backend == Backend::Avx2 {
+        if backend.has_avx2() {
             return Some(sum4_row_avx2 as RowKernel<u8>);
         }
         None
@@ -312,7 +312,7 @@ impl SumTexel for u8 {
 impl SumTexel for u16 {
     fn row_kernel(backend: Backend) -> Option<RowKernel<u16>> {
         #[cfg(target_arch = "x86_64")]
-        if backend == Backend::Avx2 {
+        if backend.has_avx2() {
             return Some(sum4_u16_row_avx2 as RowKernel<u16>);
         }
         None

@@ -40,7 +40,7 @@ pub(super) fn quads<T: Quad, const K: usize>(
     #[cfg(target_arch = "x86_64")]
     if n >= 8
         && src.iter().all(|s| s.len() < i32::MAX as usize && T::gather_safe(max_base, lw, s.len()))
-        && backend == Backend::Avx2
+        && backend.has_avx2()
     {
         // SAFETY: a resolved Avx2 means the CPU has AVX2; every gather reads inside its source (checked just above).
         done = unsafe { quads_avx2(src, lw, &bases[..n], &fx[..n], &fy[..n], scale, &mut out) };

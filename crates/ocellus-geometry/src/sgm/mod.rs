@@ -356,7 +356,7 @@ fn costs_kernel(backend: Backend, cl: &Plane<u64>, cr: &Plane<u64>, cost: &mut [
         unsafe fn fast(cl: &Plane<u64>, cr: &Plane<u64>, cost: &mut [u8], d: usize) {
             costs_generic(cl, cr, cost, d)
         }
-        if backend.resolve() == Backend::Avx2 && is_x86_feature_detected!("popcnt") {
+        if backend.has_avx2() && is_x86_feature_detected!("popcnt") {
             // SAFETY: the CPU has AVX2 (resolve) and POPCNT (checked).
             return unsafe { fast(cl, cr, cost, d) };
         }
