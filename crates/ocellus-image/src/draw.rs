@@ -56,15 +56,15 @@ pub fn dot(img: &mut Plane<[u8; 3]>, p: [f64; 2], color: [u8; 3]) {
 /// size of the first panel (smaller panels are padded with black, larger ones cut).
 pub fn grid2x2(panels: [&Plane<[u8; 3]>; 4]) -> Plane<[u8; 3]> {
     let (w, h) = panels[0].size();
-    Plane::from_fn(2 * w, 2 * h, |x, y| {
-        let p = panels[(y / h) * 2 + x / w];
-        let (px, py) = (x % w, y % h);
-        if px < p.width() && py < p.height() {
-            p.get(px, py)
-        } else {
-            [0, 0, 0]
+    let mut out = Plane::new(2 * w, 2 * h);
+    for (i, p) in panels.iter().enumerate() {
+        let (ox, oy) = ((i % 2) * w, (i / 2) * h);
+        let n = p.width().min(w);
+        for y in 0..p.height().min(h) {
+            out.row_mut(oy + y)[ox..ox + n].copy_from_slice(&p.row(y)[..n]);
         }
-    })
+    }
+    out
 }
 
 /// `img` reduced by 2 in each direction (2x2 box average; odd last row/column dropped).
@@ -83,6 +83,18 @@ pub fn half_size(img: &Plane<[u8; 3]>) -> Plane<[u8; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_grid_places_each_panel_in_its_quarter() {
+        let a = Plane::from_fn(3, 2, |x, y| [x as u8, y as u8, 1]);
+        let small = Plane::from_fn(2, 1, |_, _| [9u8; 3]);
+        let big = Plane::from_fn(5, 5, |_, _| [7u8; 3]);
+        let g = grid2x2([&a, &small, &big, &a]);
+        assert_eq!(g.size(), (6, 4));
+        assert_eq!((g.get(2, 1), g.get(5, 3)), ([2, 1, 1], [2, 1, 1]));
+        assert_eq!((g.get(3, 0), g.get(5, 0), g.get(3, 1)), ([9; 3], [0; 3], [0; 3]));
+        assert_eq!((g.get(0, 2), g.get(2, 3)), ([7; 3], [7; 3]));
+    }
 
     #[test]
     fn shapes_land_where_asked_and_clip() {
