@@ -8,6 +8,7 @@
 //! - [`ply`]: coloured point clouds.
 //! - [`video`]: frame sources (image folders, Y4M, any video through the ffmpeg program) and
 //!   [`y4m`] reading and writing; [`video_writer`]: MP4 output through ffmpeg.
+//! - [`pipeline`]: the ordered frame pipeline (decode, parallel workers, in-order sink).
 //!
 //! ```
 //! use ocellus_image::Plane;
@@ -23,6 +24,7 @@
 pub mod csv;
 pub mod npy;
 pub mod pfm;
+pub mod pipeline;
 pub mod ply;
 pub mod points;
 pub mod tum;
