@@ -170,3 +170,55 @@ fn egosphere_keeps_attended_world_points_inhibited_during_a_pan() {
     assert!(dwell_with <= 30, "with ego-sphere the gaze dwelt {dwell_with} frames on one place");
     assert!(dwell_without > 2 * dwell_with, "control dwelt {dwell_without} frames");
 }
+
+/// Everything a frame's outputs hold, by value.
+fn snapshot(r: &ocellus_attention::stream::StreamFrame) -> (usize, Vec<f32>, Vec<f32>, Option<f64>, String, Vec<f32>) {
+    (r.frame, r.saliency.to_vec(), r.surprise.to_vec(), r.chaos, format!("{:?}", r.fixation), r.inhibition.to_vec())
+}
+
+#[test]
+fn workers_on_any_frames_give_the_sequential_stream_bit_for_bit() {
+    use ocellus_attention::stream::{StreamConfig, StreamEngine, StreamWorker};
+    use ocellus_io::pipeline::{run_ordered, PipelineConfig};
+    use std::sync::Arc;
+    let world: Vec<_> =
+        ["coffee.png", "rocket.jpg"].iter().map(|n| ocellus_io::read_image(data_file(n)).unwrap()).collect();
+    let object = ocellus_io::read_image(data_file("chelsea.png")).unwrap();
+    let cfg = SceneConfig { frames: 14, event_frame: 7, ..SceneConfig::new(Scenario::SuddenObject) };
+    let g = SceneGenerator::new(cfg, &world, &object).unwrap();
+    let frames: Vec<Arc<_>> = (0..g.len()).map(|k| Arc::new(g.frame(k).unwrap().0)).collect();
+    let (w, h) = frames[0].size();
+    let scfg = StreamConfig::default();
+    let mut seq = StreamEngine::new(scfg.clone(), w, h).unwrap();
+    let want: Vec<_> = frames.iter().map(|f| snapshot(&seq.process(f, 0.0, 0.0).unwrap())).collect();
+    // Each worker count through the pipeline: workers see interleaved frames and prime
+    // their flicker from the previous frame.
+    for workers in [1, 2, 3] {
+        let mut engine = StreamEngine::new(scfg.clone(), w, h).unwrap();
+        let mut k = 0;
+        let mut got = Vec::new();
+        run_ordered(
+            PipelineConfig { workers, depth: workers + 2 },
+            || -> Result<_, ocellus_attention::AttentionError> {
+                k += 1;
+                Ok((k <= frames.len()).then(|| (k.checked_sub(2).map(|p| frames[p].clone()), frames[k - 1].clone())))
+            },
+            || StreamWorker::new(&scfg, w, h),
+            |wk, i, (prev, cur)| wk.process(i, &cur, prev.as_deref()),
+            |_, maps| {
+                got.push(snapshot(&engine.process_maps(maps, 0.0, 0.0)?));
+                Ok(())
+            },
+        )
+        .unwrap();
+        assert_eq!(got.len(), want.len());
+        for (a, b) in got.iter().zip(&want) {
+            assert!(a == b, "{workers} workers: frame {} differs", b.0);
+        }
+    }
+    // Maps out of turn, and a worker without the previous frame, are errors.
+    let mut wk = StreamWorker::new(&scfg, w, h).unwrap();
+    assert!(wk.process(3, &frames[3], None).is_err());
+    let maps = wk.process(3, &frames[3], Some(&frames[2])).unwrap();
+    assert!(StreamEngine::new(scfg, w, h).unwrap().process_maps(maps, 0.0, 0.0).is_err());
+}

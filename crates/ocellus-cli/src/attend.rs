@@ -5,17 +5,19 @@ use crate::{config_file, frames, plot, ranges};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ocellus_attention::attention::{Fixation, Reason};
-use ocellus_attention::stream::{StreamConfig, StreamEngine, StreamFrame};
+use ocellus_attention::stream::{StreamConfig, StreamEngine, StreamFrame, StreamWorker};
 use ocellus_attention::surprise::SurpriseConfig;
 use ocellus_image::colormap::overlay_scaled;
 use ocellus_image::convert::RgbImage;
 use ocellus_image::draw;
 use ocellus_image::Backend;
 use ocellus_image::Plane;
+use ocellus_io::pipeline::{run_ordered, PipelineConfig, PipelineError};
 use ocellus_io::video_writer::VideoWriter;
 use plotters::style::RGBColor;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Arguments of `ocellus attend`.
 #[derive(Args, Debug)]
@@ -38,12 +40,20 @@ pub struct AttendArgs {
     /// Do not write per-frame overlay PNGs (the video, CSVs and plot are still written).
     #[arg(long)]
     pub no_overlays: bool,
+    /// Do not write overlays.mp4 (with --no-overlays no overlay is drawn at all: the
+    /// fastest run, CSVs and plot only).
+    #[arg(long)]
+    pub no_video: bool,
     /// Frame rate of the overlay video, frames per second. Range: 1..=1000.
     #[arg(long, default_value_t = 30, value_parser = ranges::within(1u32, 1000))]
     pub fps: u32,
     /// Process at most N frames. Range: 1..=10000000.
     #[arg(long, value_parser = ranges::within(1usize, 10_000_000))]
     pub limit: Option<usize>,
+    /// Worker threads for the per-frame work (saliency, and drawing and writing the
+    /// overlays); 0: one per core. The results do not depend on it. Range: 0..=256.
+    #[arg(long, default_value_t = 0, value_parser = ranges::within(0usize, 256))]
+    pub workers: usize,
 }
 
 /// Options shared by the commands that run the stream engine.
@@ -78,11 +88,10 @@ impl Default for StreamOptions {
     }
 }
 
-/// Where per-frame results go.
+/// Where the per-frame values go (in frame order): the CSVs and the plot's series.
 struct Outputs {
     dir: PathBuf,
     overlays: bool,
-    video: Option<VideoWriter>,
     scanpath: crate::output_files::OutputFile,
     context: crate::output_files::OutputFile,
     chaos: Vec<(f64, f64)>,
@@ -93,6 +102,16 @@ struct Outputs {
 
 fn create(dir: &Path, name: &str) -> Result<crate::output_files::OutputFile> {
     crate::output_files::create_file(&dir.join(name))
+}
+
+/// What drawing one overlay needs, owned so that a render worker can take it.
+struct RenderJob {
+    frame: Arc<RgbImage>,
+    saliency: Plane<f32>,
+    surprise: Plane<f32>,
+    inhibition: Plane<f32>,
+    fixation: Option<Fixation>,
+    recent: Vec<Fixation>,
 }
 
 impl Outputs {
@@ -112,7 +131,6 @@ impl Outputs {
         Ok(Self {
             dir: dir.into(),
             overlays,
-            video: None,
             scanpath,
             context,
             chaos: Vec::new(),
@@ -122,7 +140,8 @@ impl Outputs {
         })
     }
 
-    fn record(&mut self, frame: &RgbImage, r: &StreamFrame, fps: u32) -> Result<()> {
+    /// Writes frame `r`'s rows and returns what its overlay needs (when `draw`).
+    fn record(&mut self, frame: Arc<RgbImage>, r: &StreamFrame, draw: bool) -> Result<Option<RenderJob>> {
         let k = r.frame;
         let smax = r.surprise.min_max().1;
         let (fx, fy, reason) = match r.fixation {
@@ -157,30 +176,23 @@ impl Outputs {
                 self.recent.remove(0);
             }
         }
-        let img = composite(frame, r, &self.recent)?;
-        if self.overlays {
-            let p = self.dir.join("overlays").join(format!("frame_{k:05}.png"));
-            ocellus_io::write_png(&p, &img)?;
-        }
-        if k == 0 {
-            self.video = VideoWriter::start(&self.dir.join("overlays.mp4"), img.width(), img.height(), fps)?;
-            if self.video.is_none() {
-                errln!("note: ffmpeg not found; no overlays.mp4 (scripts/setup.sh installs it)");
-            }
-        }
-        if let Some(v) = self.video.as_mut() {
-            v.write(&img)?;
-        }
-        Ok(())
+        Ok(draw.then(|| RenderJob {
+            frame,
+            saliency: r.saliency.clone(),
+            surprise: r.surprise.clone(),
+            inhibition: r.inhibition.clone(),
+            fixation: r.fixation,
+            recent: self.recent.clone(),
+        }))
     }
 
-    /// Flushes the CSVs, closes the video and draws the plot; returns what was written.
-    fn finish(mut self, threshold: f64) -> Result<Vec<String>> {
+    /// Flushes the CSVs and draws the plot; returns what was written (`video`: whether
+    /// overlays.mp4 was).
+    fn finish(mut self, threshold: f64, video: bool) -> Result<Vec<String>> {
         self.scanpath.flush()?;
         self.context.flush()?;
         let mut written = vec!["scanpath.csv".to_string(), "context.csv".into()];
-        if let Some(v) = self.video.take() {
-            v.finish()?;
+        if video {
             written.push("overlays.mp4".into());
         }
         if self.overlays {
@@ -206,19 +218,66 @@ impl Outputs {
     }
 }
 
+/// Draws the overlays of the jobs `jobs` delivers, on `workers` threads (each writing its
+/// frames' PNGs when `png_dir` is given), and feeds them in frame order to overlays.mp4 in
+/// `dir` (when `video`). Returns whether the video was written.
+fn render(
+    jobs: std::sync::mpsc::Receiver<RenderJob>,
+    workers: usize,
+    png_dir: Option<&Path>,
+    dir: &Path,
+    fps: u32,
+    video_wanted: bool,
+) -> Result<bool> {
+    let mut video: Option<VideoWriter> = None;
+    let r = run_ordered(
+        PipelineConfig::with_workers(workers),
+        move || Ok(jobs.recv().ok()),
+        || Ok(()),
+        |_, k, job: RenderJob| -> Result<Plane<[u8; 3]>> {
+            let img = composite(&job)?;
+            if let Some(d) = png_dir {
+                ocellus_io::write_png(d.join(format!("frame_{k:05}.png")), &img)?;
+            }
+            Ok(img)
+        },
+        |k, img| {
+            if k == 0 && video_wanted {
+                video = VideoWriter::start(&dir.join("overlays.mp4"), img.width(), img.height(), fps)?;
+                if video.is_none() {
+                    errln!("note: ffmpeg not found; no overlays.mp4 (scripts/setup.sh installs it)");
+                }
+            }
+            if let Some(v) = video.as_mut() {
+                v.write(&img)?;
+            }
+            Ok(())
+        },
+    );
+    let wrote = video.is_some();
+    if let Some(v) = video.take() {
+        v.finish()?;
+    }
+    match r {
+        Ok(_) => Ok(wrote),
+        Err(PipelineError::Stage(e)) => Err(e),
+        Err(e) => Err(anyhow::anyhow!("{e}")),
+    }
+}
+
 /// The overlay image: [frame with fixations | saliency] over [surprise | inhibition], each
 /// panel at half the frame size (even sizes, for video).
-fn composite(frame: &RgbImage, r: &StreamFrame, recent: &[Fixation]) -> Result<Plane<[u8; 3]>> {
-    let px = frame.to_u8();
+fn composite(r: &RenderJob) -> Result<Plane<[u8; 3]>> {
+    let px = r.frame.to_u8();
     let mut half = draw::half_size(&px);
     let (w, h) = (half.width() & !1, half.height() & !1);
     half = Plane::from_fn(w.max(2), h.max(2), |x, y| half.get(x.min(half.width() - 1), y.min(half.height() - 1)));
-    let sal = overlay_scaled(Backend::Auto, &half, r.saliency, 0.0)?;
+    let sal = overlay_scaled(Backend::Auto, &half, &r.saliency, 0.0)?;
     // Surprise on a fixed scale up to 10 bits, so quiet frames look quiet.
-    let sur = overlay_scaled(Backend::Auto, &half, r.surprise, 10.0)?;
-    let inh = overlay_scaled(Backend::Auto, &half, r.inhibition, 1.0)?;
+    let sur = overlay_scaled(Backend::Auto, &half, &r.surprise, 10.0)?;
+    let inh = overlay_scaled(Backend::Auto, &half, &r.inhibition, 1.0)?;
     let mut view = half.clone();
-    for f in recent {
+    for f in &r.recent {
         draw::ring(&mut view, (f.x - 0.5) / 2.0, (f.y - 0.5) / 2.0, 6.0, [255, 255, 255]);
     }
     if let Some(f) = r.fixation {
@@ -240,6 +299,12 @@ pub fn run(a: AttendArgs) -> Result<()> {
 }
 
 /// Runs the subcommand without the summary line: (frames, saccades, files written).
+///
+/// Three stages run at once: decoding; saliency on `workers` threads
+/// (`ocellus_attention::stream::StreamWorker`, through the ordered pipeline); then, in
+/// frame order, surprise, chaos and attention with the CSV rows; and the overlays drawn and
+/// written on `workers` threads, fed to the video in order. Bounded queues between them
+/// keep the memory fixed whatever the length of the stream.
 pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
     let cfg = a.stream.config(a.deg_per_px)?;
     let pan_tilt = a.pan_tilt.as_deref().map(frames::read_pan_tilt).transpose()?;
@@ -249,22 +314,53 @@ pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
     let mut out = Outputs::new(&a.out, !a.no_overlays)?;
     let mut engine: Option<StreamEngine> = None;
     let threshold = cfg.chaos.threshold;
-    let result = frames::for_each_frame(&a.input, a.limit, |k, frame| {
-        let (w, h) = frame.size();
-        if engine.is_none() {
-            engine = Some(StreamEngine::new(cfg.clone(), w, h)?);
-        }
-        let Some(e) = engine.as_mut() else { bail!("no engine") };
-        let (pan, tilt) = match &pan_tilt {
-            Some(v) => *v.get(k).with_context(|| format!("the pan-tilt CSV has no row for frame {k}"))?,
-            None => (0.0, 0.0),
-        };
-        let r = e.process(frame, pan, tilt)?;
-        out.record(frame, &r, a.fps)
+    let png_dir = (!a.no_overlays).then(|| a.out.join("overlays"));
+    let workers = a.workers;
+    let draw = png_dir.is_some() || !a.no_video;
+    let (result, rendered) = std::thread::scope(|scope| {
+        let (job_tx, job_rx) = std::sync::mpsc::sync_channel::<RenderJob>(2);
+        let renderer = scope.spawn(|| {
+            if draw {
+                render(job_rx, workers, png_dir.as_deref(), &a.out, a.fps, !a.no_video)
+            } else {
+                // Nothing to draw: take the jobs as they come.
+                job_rx.iter().for_each(drop);
+                Ok(false)
+            }
+        });
+        let result = frames::for_each_frame_parallel(
+            &a.input,
+            a.limit,
+            workers,
+            |w, h| Ok(StreamWorker::new(&cfg, w, h)?),
+            |worker, k, pair| Ok((worker.process(k, &pair.cur, pair.prev.as_deref())?, pair.cur)),
+            |k, (maps, frame)| {
+                let (w, h) = frame.size();
+                let e = match engine.as_mut() {
+                    Some(e) => e,
+                    None => engine.insert(StreamEngine::new(cfg.clone(), w, h)?),
+                };
+                let (pan, tilt) = match &pan_tilt {
+                    Some(v) => *v.get(k).with_context(|| format!("the pan-tilt CSV has no row for frame {k}"))?,
+                    None => (0.0, 0.0),
+                };
+                let r = e.process_maps(maps, pan, tilt)?;
+                let job = out.record(frame, &r, draw)?;
+                if job.is_some_and(|j| job_tx.send(j).is_err()) {
+                    bail!("the overlay writer stopped");
+                }
+                Ok(())
+            },
+        );
+        // The renderer ends when the queue is closed and empty.
+        drop(job_tx);
+        let rendered = renderer.join().unwrap_or_else(|_| Err(anyhow::anyhow!("the overlay writer panicked")));
+        (result, rendered)
     });
     // Whatever happened, what was processed is written out.
     let saccades = out.saccades;
-    let written = out.finish(threshold)?;
+    let written = out.finish(threshold, *rendered.as_ref().unwrap_or(&false))?;
     let n = result?;
+    rendered?;
     Ok((n, saccades, written))
 }

@@ -90,6 +90,8 @@ pub fn run(a: DemoArgs) -> Result<()> {
         no_overlays: false,
         fps: 30,
         limit: None,
+        no_video: false,
+        workers: 0,
     };
     let (n, saccades, written) = attend::run_quiet(args)?;
     outln!(

@@ -197,11 +197,13 @@ impl Ffmpeg {
             }
         }
         if got == n {
-            let (w, buf) = (self.width, &self.buf);
-            let px = ocellus_image::Plane::from_fn(w, self.height, |x, y| {
-                let i = 3 * (y * w + x);
-                [buf[i], buf[i + 1], buf[i + 2]]
-            });
+            // One pass over the bytes (a copy the compiler vectorizes), not a call per pixel.
+            let data: Vec<[u8; 3]> = self.buf.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+            let px = ocellus_image::Plane::from_vec(self.width, self.height, data).map_err(|e| IoError::Video {
+                path: path.into(),
+                frame,
+                reason: e.to_string(),
+            })?;
             return Ok(Some(RgbImage::U8(px)));
         }
         let status = self.child.wait().map_err(|e| IoError::Ffmpeg(e.to_string()))?;

@@ -438,6 +438,18 @@ impl SaliencyEngine {
         }
     }
 
+    /// Makes `frame` the previous frame of the flicker channel, computing only its pyramids:
+    /// an engine that next processes frame k of a stream, having last processed some frame
+    /// other than k - 1 (a worker of a parallel pipeline), primes with frame k - 1 and then
+    /// gives exactly the maps of a sequential run. Nothing to do without a flicker channel.
+    pub fn prime_temporal(&mut self, frame: &RgbImage) -> Result<()> {
+        if !self.cfg.channels.iter().any(|c| c.kind == ChannelKind::Flicker) {
+            return Ok(());
+        }
+        ocellus_image::check::same_size("frame (against the engine's)", frame.size(), (self.width, self.height))?;
+        self.build_pyramids(frame, &[])
+    }
+
     /// Forgets the previous frame, so that the next frame has no flicker (e.g. after a cut).
     pub fn reset_temporal(&mut self) {
         for p in &mut self.pyr.prev_intensity {

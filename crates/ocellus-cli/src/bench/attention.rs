@@ -1,5 +1,6 @@
 //! `ocellus bench attention`: the per-frame cost of surprise, chaos and attention on top of
-//! saliency, and end-to-end frames per second of `ocellus attend` from video files.
+//! saliency, and end-to-end frames per second of `ocellus attend` from video files (1 and 2
+//! workers, with and without overlay PNGs), with its peak memory after 10^3 and 10^4 frames.
 
 use super::timing::{median, peak_rss_mb};
 use crate::attend::{self, AttendArgs, StreamOptions};
@@ -90,8 +91,10 @@ fn analysis_fps(video: &Path) -> Result<f64> {
     Ok(n as f64 / t.elapsed().as_secs_f64())
 }
 
-/// Frames per second of the `ocellus attend` command itself (all outputs written).
-fn attend_fps(video: &Path, out: &Path, overlays: bool) -> Result<f64> {
+/// Frames per second of the `ocellus attend` command itself (all outputs written) over a
+/// video of `frames` frames, and its peak resident memory in MiB (the high-water mark is
+/// reset first where Linux allows).
+fn attend_fps(video: &Path, out: &Path, overlays: bool, workers: usize, frames: usize) -> Result<(f64, Option<f64>)> {
     let args = AttendArgs {
         input: video.into(),
         pan_tilt: None,
@@ -99,12 +102,38 @@ fn attend_fps(video: &Path, out: &Path, overlays: bool) -> Result<f64> {
         out: out.into(),
         stream: StreamOptions::default(),
         no_overlays: !overlays,
+        no_video: !overlays,
         fps: 30,
         limit: None,
+        workers,
     };
+    // "5" resets the peak resident set size of this process (Linux 4.0 and later).
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
     let t = Instant::now();
-    attend::run_quiet(args)?;
-    Ok(SEQUENCE as f64 / t.elapsed().as_secs_f64())
+    let (n, _, _) = attend::run_quiet(args)?;
+    let fps = n as f64 / t.elapsed().as_secs_f64();
+    if n != frames {
+        anyhow::bail!("attend read {n} frames of {}, expected {frames}", video.display());
+    }
+    let _ = std::fs::remove_dir_all(out);
+    Ok((fps, peak_rss_mb()))
+}
+
+/// `src` looped into a video of `loops` copies (`sequence` frames each), without
+/// re-encoding.
+fn looped(src: &Path, dst: &Path, loops: usize) -> Result<()> {
+    let st = std::process::Command::new("ffmpeg")
+        .args(["-v", "error", "-y", "-stream_loop"])
+        .arg((loops - 1).to_string())
+        .arg("-i")
+        .arg(src)
+        .args(["-c", "copy"])
+        .arg(dst)
+        .status()?;
+    if !st.success() {
+        anyhow::bail!("ffmpeg could not loop {}", src.display());
+    }
+    Ok(())
 }
 
 fn has_ffmpeg() -> bool {
@@ -135,8 +164,31 @@ pub fn run(json_out: bool, n: usize) -> Result<()> {
             .status()?;
         if st.success() {
             e2e.insert("fps_analysis_from_mp4".into(), json!(analysis_fps(&mp4)?));
-            e2e.insert("fps_attend_mp4_no_overlays".into(), json!(attend_fps(&mp4, &dir.join("a1"), false)?));
-            e2e.insert("fps_attend_mp4_with_overlays".into(), json!(attend_fps(&mp4, &dir.join("a2"), true)?));
+            // About 10^3 frames: 21 loops of the sequence.
+            let (loops_k, loops_10k) = (21, 209);
+            let long = dir.join("long.mp4");
+            looped(&mp4, &long, loops_k)?;
+            let n = loops_k * SEQUENCE;
+            e2e.insert("attend_frames".into(), json!(n));
+            for workers in [1, 2] {
+                for overlays in [false, true] {
+                    let (fps, _) = attend_fps(&long, &dir.join("a"), overlays, workers, n)?;
+                    let key = format!(
+                        "fps_attend_mp4_{}_{workers}_workers",
+                        if overlays { "with_overlays" } else { "no_overlays" }
+                    );
+                    e2e.insert(key, json!(fps));
+                }
+            }
+            // Memory is bounded by the queues: the same peak after 10^3 and 10^4 frames.
+            let (_, rss_k) = attend_fps(&long, &dir.join("a"), false, 2, n)?;
+            let longer = dir.join("longer.mp4");
+            looped(&mp4, &longer, loops_10k)?;
+            let (fps_10k, rss_10k) = attend_fps(&longer, &dir.join("a"), false, 2, loops_10k * SEQUENCE)?;
+            e2e.insert("peak_rss_mb_attend_1e3_frames".into(), json!(rss_k));
+            e2e.insert("peak_rss_mb_attend_1e4_frames".into(), json!(rss_10k));
+            e2e.insert("attend_long_frames".into(), json!(loops_10k * SEQUENCE));
+            e2e.insert("fps_attend_mp4_no_overlays_2_workers_1e4_frames".into(), json!(fps_10k));
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
@@ -145,7 +197,6 @@ pub fn run(json_out: bool, n: usize) -> Result<()> {
         "frame_height": 480,
         "temporal": temporal,
         "end_to_end": e2e,
-        "end_to_end_frames": SEQUENCE,
         "peak_rss_mb": peak_rss_mb(),
     });
     if json_out {
@@ -162,9 +213,9 @@ pub fn run(json_out: bool, n: usize) -> Result<()> {
         f("us_chaos"),
         f("us_attention")
     );
-    outln!("end to end over {SEQUENCE} frames (decode included):");
+    outln!("end to end (decode and writing included):");
     for (k, val) in e2e {
-        outln!("  {k:<32} {:.1} fps", val.as_f64().unwrap_or(f64::NAN));
+        outln!("  {k:<48} {:.1}", val.as_f64().unwrap_or(f64::NAN));
     }
     if let Some(m) = v["peak_rss_mb"].as_f64() {
         outln!("peak resident memory: {m:.1} MiB");
