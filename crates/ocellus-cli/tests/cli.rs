@@ -307,6 +307,32 @@ fn attend_finds_the_sudden_object_and_writes_every_output() {
 }
 
 #[test]
+fn attend_gives_the_same_results_at_any_number_of_workers() {
+    let dir = tmpdir("attend-workers");
+    let seq = dir.join("seq");
+    generate(&seq, "sudden", 14, 7, false);
+    let run = |workers: &str| {
+        let out = dir.join(format!("out{workers}"));
+        let o = ocellus()
+            .arg("attend")
+            .arg(seq.join("frames"))
+            .args(["--no-overlays", "--no-video", "--workers", workers, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(!out.join("overlays.mp4").exists() && !out.join("overlays").exists());
+        // Every column but the two timings.
+        let context: Vec<Vec<String>> =
+            csv_rows(&out.join("context.csv")).into_iter().map(|r| r[..7].to_vec()).collect();
+        (context, std::fs::read_to_string(out.join("scanpath.csv")).unwrap())
+    };
+    let one = run("1");
+    assert_eq!(one.0.len(), 14);
+    assert_eq!(run("3"), one);
+}
+
+#[test]
 fn attend_on_a_cut_video_keeps_the_frames_before_and_names_the_frame() {
     let dir = tmpdir("attend-cut");
     let seq = dir.join("seq");
