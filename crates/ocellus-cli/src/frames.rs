@@ -17,6 +17,16 @@ pub struct FramePair {
     pub cur: Arc<RgbImage>,
 }
 
+/// The frames of `input` and a progress bar for at most `limit` of them.
+fn open_with_progress(input: &Path, limit: Option<usize>) -> Result<(ocellus_io::video::Frames, ProgressBar)> {
+    let frames = crate::budget::open_frames(input)?;
+    let total = match (frames.len_hint(), limit) {
+        (Some(n), Some(l)) => Some(n.min(l)),
+        (n, l) => n.or(l),
+    };
+    Ok((frames, progress(total)))
+}
+
 /// The progress bar of a stream of `total` frames (a spinner when unknown).
 fn progress(total: Option<usize>) -> ProgressBar {
     match total {
@@ -49,12 +59,7 @@ pub fn for_each_frame_parallel<S, U: Send>(
     work: impl Fn(&mut S, usize, FramePair) -> Result<U> + Sync,
     mut sink: impl FnMut(usize, U) -> Result<()>,
 ) -> Result<usize> {
-    let mut frames = crate::budget::open_frames(input)?;
-    let total = match (frames.len_hint(), limit) {
-        (Some(n), Some(l)) => Some(n.min(l)),
-        (n, l) => n.or(l),
-    };
-    let bar = progress(total);
+    let (mut frames, bar) = open_with_progress(input, limit)?;
     let mut delivered = 0;
     let mut prev: Option<Arc<RgbImage>> = None;
     let mut k = 0;
@@ -134,12 +139,7 @@ pub fn for_each_frame(
     limit: Option<usize>,
     mut f: impl FnMut(usize, &RgbImage) -> Result<()>,
 ) -> Result<usize> {
-    let mut frames = crate::budget::open_frames(input)?;
-    let total = match (frames.len_hint(), limit) {
-        (Some(n), Some(l)) => Some(n.min(l)),
-        (n, l) => n.or(l),
-    };
-    let bar = progress(total);
+    let (mut frames, bar) = open_with_progress(input, limit)?;
     let mut k = 0;
     while limit.map_or(true, |l| k < l) {
         let frame = match frames.next_frame() {
