@@ -12,7 +12,6 @@ use ocellus_image::convert::RgbImage;
 use ocellus_image::draw;
 use ocellus_image::Backend;
 use ocellus_image::Plane;
-use ocellus_io::pipeline::{run_ordered, PipelineConfig, PipelineError};
 use ocellus_io::video_writer::VideoWriter;
 use plotters::style::RGBColor;
 use std::io::Write;
@@ -218,53 +217,6 @@ impl Outputs {
     }
 }
 
-/// Draws the overlays of the jobs `jobs` delivers, on `workers` threads (each writing its
-/// frames' PNGs when `png_dir` is given), and feeds them in frame order to overlays.mp4 in
-/// `dir` (when `video`). Returns whether the video was written.
-fn render(
-    jobs: std::sync::mpsc::Receiver<RenderJob>,
-    workers: usize,
-    png_dir: Option<&Path>,
-    dir: &Path,
-    fps: u32,
-    video_wanted: bool,
-) -> Result<bool> {
-    let mut video: Option<VideoWriter> = None;
-    let r = run_ordered(
-        PipelineConfig::with_workers(workers),
-        move || Ok(jobs.recv().ok()),
-        || Ok(()),
-        |_, k, job: RenderJob| -> Result<Plane<[u8; 3]>> {
-            let img = composite(&job)?;
-            if let Some(d) = png_dir {
-                ocellus_io::write_png(d.join(format!("frame_{k:05}.png")), &img)?;
-            }
-            Ok(img)
-        },
-        |k, img| {
-            if k == 0 && video_wanted {
-                video = VideoWriter::start(&dir.join("overlays.mp4"), img.width(), img.height(), fps)?;
-                if video.is_none() {
-                    errln!("note: ffmpeg not found; no overlays.mp4 (scripts/setup.sh installs it)");
-                }
-            }
-            if let Some(v) = video.as_mut() {
-                v.write(&img)?;
-            }
-            Ok(())
-        },
-    );
-    let wrote = video.is_some();
-    if let Some(v) = video.take() {
-        v.finish()?;
-    }
-    match r {
-        Ok(_) => Ok(wrote),
-        Err(PipelineError::Stage(e)) => Err(e),
-        Err(e) => Err(anyhow::anyhow!("{e}")),
-    }
-}
-
 /// The overlay image: [frame with fixations | saliency] over [surprise | inhibition], each
 /// panel at half the frame size (even sizes, for video).
 fn composite(r: &RenderJob) -> Result<Plane<[u8; 3]>> {
@@ -317,49 +269,62 @@ pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
     let png_dir = (!a.no_overlays).then(|| a.out.join("overlays"));
     let workers = a.workers;
     let draw = png_dir.is_some() || !a.no_video;
-    let (result, rendered) = std::thread::scope(|scope| {
-        let (job_tx, job_rx) = std::sync::mpsc::sync_channel::<RenderJob>(2);
-        let renderer = scope.spawn(|| {
-            if draw {
-                render(job_rx, workers, png_dir.as_deref(), &a.out, a.fps, !a.no_video)
-            } else {
-                // Nothing to draw: take the jobs as they come.
-                job_rx.iter().for_each(drop);
-                Ok(false)
+    let mut video: Option<VideoWriter> = None;
+    let (result, rendered) = frames::with_ordered_writer(
+        workers,
+        // Each job's overlay, drawn and written on the writer threads.
+        |k, job: RenderJob| -> Result<Plane<[u8; 3]>> {
+            let img = composite(&job)?;
+            if let Some(d) = &png_dir {
+                ocellus_io::write_png(d.join(format!("frame_{k:05}.png")), &img)?;
             }
-        });
-        let result = frames::for_each_frame_parallel(
-            &a.input,
-            a.limit,
-            workers,
-            |w, h| Ok(StreamWorker::new(&cfg, w, h)?),
-            |worker, k, pair| Ok((worker.process(k, &pair.cur, pair.prev.as_deref())?, pair.cur)),
-            |k, (maps, frame)| {
-                let (w, h) = frame.size();
-                let e = match engine.as_mut() {
-                    Some(e) => e,
-                    None => engine.insert(StreamEngine::new(cfg.clone(), w, h)?),
-                };
-                let (pan, tilt) = match &pan_tilt {
-                    Some(v) => *v.get(k).with_context(|| format!("the pan-tilt CSV has no row for frame {k}"))?,
-                    None => (0.0, 0.0),
-                };
-                let r = e.process_maps(maps, pan, tilt)?;
-                let job = out.record(frame, &r, draw)?;
-                if job.is_some_and(|j| job_tx.send(j).is_err()) {
-                    bail!("the overlay writer stopped");
+            Ok(img)
+        },
+        // Then fed to the video in frame order.
+        |k, img| {
+            if k == 0 && !a.no_video {
+                video = VideoWriter::start(&a.out.join("overlays.mp4"), img.width(), img.height(), a.fps)?;
+                if video.is_none() {
+                    errln!("note: ffmpeg not found; no overlays.mp4 (scripts/setup.sh installs it)");
                 }
-                Ok(())
-            },
-        );
-        // The renderer ends when the queue is closed and empty.
-        drop(job_tx);
-        let rendered = renderer.join().unwrap_or_else(|_| Err(anyhow::anyhow!("the overlay writer panicked")));
-        (result, rendered)
-    });
+            }
+            if let Some(v) = video.as_mut() {
+                v.write(&img)?;
+            }
+            Ok(())
+        },
+        |jobs| {
+            frames::for_each_frame_parallel(
+                &a.input,
+                a.limit,
+                workers,
+                |w, h| Ok(StreamWorker::new(&cfg, w, h)?),
+                |worker, k, pair| Ok((worker.process(k, &pair.cur, pair.prev.as_deref())?, pair.cur)),
+                |k, (maps, frame)| {
+                    let (w, h) = frame.size();
+                    let e = match engine.as_mut() {
+                        Some(e) => e,
+                        None => engine.insert(StreamEngine::new(cfg.clone(), w, h)?),
+                    };
+                    let (pan, tilt) = match &pan_tilt {
+                        Some(v) => *v.get(k).with_context(|| format!("the pan-tilt CSV has no row for frame {k}"))?,
+                        None => (0.0, 0.0),
+                    };
+                    let r = e.process_maps(maps, pan, tilt)?;
+                    let job = out.record(frame, &r, draw)?;
+                    if job.is_some_and(|j| jobs.send(j).is_err()) {
+                        bail!("the overlay writer stopped");
+                    }
+                    Ok(())
+                },
+            )
+        },
+    );
+    let wrote_video = video.is_some();
+    let rendered = rendered.and_then(|()| video.take().map_or(Ok(()), |v| Ok(v.finish()?)));
     // Whatever happened, what was processed is written out.
     let saccades = out.saccades;
-    let written = out.finish(threshold, *rendered.as_ref().unwrap_or(&false))?;
+    let written = out.finish(threshold, wrote_video && rendered.is_ok())?;
     let n = result?;
     rendered?;
     Ok((n, saccades, written))

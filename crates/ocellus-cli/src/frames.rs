@@ -8,6 +8,15 @@ use ocellus_io::pipeline::{run_ordered, PipelineConfig, PipelineError};
 use std::path::Path;
 use std::sync::Arc;
 
+/// A pipeline's outcome as an `anyhow` result: a stage's error as it was.
+pub fn pipeline_result<T>(r: std::result::Result<T, PipelineError<anyhow::Error>>) -> Result<T> {
+    match r {
+        Ok(t) => Ok(t),
+        Err(PipelineError::Stage(e)) => Err(e),
+        Err(e) => Err(anyhow::anyhow!("{e}")),
+    }
+}
+
 /// A frame for a pipeline worker, with the frame before it (for flicker and frame
 /// differences); frames are shared, not copied.
 pub struct FramePair {
@@ -125,11 +134,37 @@ pub fn for_each_frame_parallel<S, U: Send>(
         },
     );
     bar.finish_and_clear();
-    match r {
-        Ok(_) => Ok(delivered),
-        Err(PipelineError::Stage(e)) => Err(e),
-        Err(e) => Err(anyhow::anyhow!("{e}")),
-    }
+    pipeline_result(r).map(|_| delivered)
+}
+
+/// Runs `body` with a sender of jobs while `work(k, job)` runs on `workers` threads (0: one
+/// per core) on the jobs in the order sent and `sink(k, result)`, on a thread of its own,
+/// receives the results in that order (to feed a video, say). Returns what `body` returned
+/// and the writers' outcome (the first error, in order). The queue is bounded: `body` waits
+/// when the writers fall behind.
+pub fn with_ordered_writer<J: Send, U: Send, R>(
+    workers: usize,
+    work: impl Fn(usize, J) -> Result<U> + Sync,
+    sink: impl FnMut(usize, U) -> Result<()> + Send,
+    body: impl FnOnce(&std::sync::mpsc::SyncSender<J>) -> R,
+) -> (R, Result<()>) {
+    std::thread::scope(|scope| {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<J>(2);
+        let writer = scope.spawn(|| {
+            let r = run_ordered(
+                PipelineConfig::with_workers(workers),
+                move || Ok(rx.recv().ok()),
+                || Ok(()),
+                |_, k, job| work(k, job),
+                sink,
+            );
+            pipeline_result(r).map(|_| ())
+        });
+        let out = body(&tx);
+        // The writer ends when the queue is closed and empty.
+        drop(tx);
+        (out, writer.join().unwrap_or_else(|_| Err(anyhow::anyhow!("the writer thread panicked"))))
+    })
 }
 
 /// Calls `f(k, frame)` for each frame (at most `limit`). If the source fails at frame k, the

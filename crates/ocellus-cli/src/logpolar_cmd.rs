@@ -2,7 +2,7 @@
 //! `logpolar register A B`: rotation and scale between two images; `logpolar vergence L R`:
 //! disparity at a gaze point of a stereo pair.
 
-use crate::frames::for_each_frame;
+use crate::frames::for_each_frame_parallel;
 use crate::ranges;
 use anyhow::{bail, Result};
 use clap::{Args, Subcommand, ValueEnum};
@@ -50,6 +50,10 @@ pub struct LogPolarArgs {
     /// when ffmpeg is installed.
     #[arg(long, default_value = "ocellus-logpolar")]
     out: PathBuf,
+    /// Worker threads for a stream (sampling and writing each frame); 0: one per core. The
+    /// results do not depend on it. Range: 0..=256.
+    #[arg(long, default_value_t = 0, value_parser = ranges::within(0usize, 256))]
+    workers: usize,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -191,46 +195,61 @@ fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
     for v in ["cortex.mp4", "inverse.mp4"] {
         ocellus_io::video_writer::check_output(&a.out.join(v))?;
     }
-    let mut state: Option<(LogPolarMap, Scratch, Option<VideoWriter>, Option<VideoWriter>)> = None;
-    let (mut out, mut spent) = (<[Plane<f32>; 3]>::default(), Vec::new());
-    let n = for_each_frame(input, None, |k, frame| {
-        let rgb = frame.to_u8();
-        let (w, h) = rgb.size();
-        if state.is_none() {
-            let map = LogPolarMap::new(&config(a, w, h), w, h)?;
-            let (cw, ch) = (map.sectors(), map.rows());
-            let cortex_video = VideoWriter::start(&a.out.join("cortex.mp4"), cw + cw % 2, ch + ch % 2, 30)?;
-            let inverse_video = VideoWriter::start(&a.out.join("inverse.mp4"), w + w % 2, h + h % 2, 30)?;
-            state = Some((map, Scratch::default(), cortex_video, inverse_video));
-        }
-        let Some((map, scratch, cortex_video, inverse_video)) = state.as_mut() else { bail!("no map") };
-        if (w, h) != map.image_size() {
-            bail!("frame is {w}x{h}, the first frame was {:?}", map.image_size());
-        }
-        let t = std::time::Instant::now();
-        map.sample_rgb_into(&rgb, scratch, &mut out)?;
-        spent.push(t.elapsed().as_secs_f64() * 1e6);
-        let [r, g, b] = &out;
-        let cortex = merge_rgb8([r, g, b]);
-        ocellus_io::write_png(cortex_dir.join(format!("{k:05}.png")), &cortex)?;
-        let even = |p: &Plane<[u8; 3]>| {
-            let (pw, ph) = p.size();
-            Plane::from_fn(pw + pw % 2, ph + ph % 2, |x, y| p.get(x.min(pw - 1), y.min(ph - 1)))
-        };
-        if let Some(v) = cortex_video.as_mut() {
-            v.write(&even(&cortex))?;
-        }
-        if let Some(v) = inverse_video.as_mut() {
+    // Sampling, the cortical PNG and the inverse image on the workers (each with its own map,
+    // built for the first frame it gets); the two videos fed here in frame order.
+    let mut videos: Option<(Option<VideoWriter>, Option<VideoWriter>)> = None;
+    let mut map0: Option<LogPolarMap> = None;
+    let mut spent = Vec::new();
+    let even = |p: &Plane<[u8; 3]>| {
+        let (pw, ph) = p.size();
+        Plane::from_fn(pw + pw % 2, ph + ph % 2, |x, y| p.get(x.min(pw - 1), y.min(ph - 1)))
+    };
+    let r = for_each_frame_parallel(
+        input,
+        None,
+        a.workers,
+        |w, h| Ok((LogPolarMap::new(&config(a, w, h), w, h)?, Scratch::default(), <[Plane<f32>; 3]>::default())),
+        |(map, scratch, out), k, pair| {
+            let rgb = pair.cur.to_u8();
+            let (w, h) = rgb.size();
+            if (w, h) != map.image_size() {
+                bail!("frame is {w}x{h}, the first frame was {:?}", map.image_size());
+            }
+            let t = std::time::Instant::now();
+            map.sample_rgb_into(&rgb, scratch, out)?;
+            let us = t.elapsed().as_secs_f64() * 1e6;
+            let [r, g, b] = &*out;
+            let cortex = merge_rgb8([r, g, b]);
+            ocellus_io::write_png(cortex_dir.join(format!("{k:05}.png")), &cortex)?;
             let inverse = merge_rgb8([&map.inverse(r)?, &map.inverse(g)?, &map.inverse(b)?]);
-            v.write(&even(&inverse))?;
-        }
-        Ok(())
-    })?;
-    let Some((map, _, cortex_video, inverse_video)) = state else { bail!("{} has no frames", input.display()) };
-    let videos = cortex_video.is_some();
+            Ok((us, even(&cortex), even(&inverse), (k == 0).then(|| map.clone())))
+        },
+        |_, (us, cortex, inverse, first)| {
+            spent.push(us);
+            if let Some(m) = first {
+                map0 = Some(m);
+            }
+            if videos.is_none() {
+                let (iw, ih) = inverse.size();
+                videos = Some((
+                    VideoWriter::start(&a.out.join("cortex.mp4"), cortex.width(), cortex.height(), 30)?,
+                    VideoWriter::start(&a.out.join("inverse.mp4"), iw, ih, 30)?,
+                ));
+            }
+            if let Some((Some(c), Some(i))) = videos.as_mut() {
+                c.write(&cortex)?;
+                i.write(&inverse)?;
+            }
+            Ok(())
+        },
+    );
+    let (cortex_video, inverse_video) = videos.unwrap_or((None, None));
+    let has_videos = cortex_video.is_some();
     for v in [cortex_video, inverse_video].into_iter().flatten() {
         v.finish()?;
     }
+    let n = r?;
+    let Some(map) = map0 else { bail!("{} has no frames", input.display()) };
     spent.sort_by(f64::total_cmp);
     let median_us = spent.get(spent.len() / 2).copied().unwrap_or(0.0);
     let info = serde_json::json!({
@@ -247,7 +266,7 @@ fn run_stream(a: &LogPolarArgs, input: &Path) -> Result<()> {
         "{n} frames -> {} rows x {} sectors, {median_us:.0} us per frame (median, sampling only); wrote cortex/NNNNN.png{}, logpolar.json in {}",
         map.rows(),
         map.sectors(),
-        if videos { ", cortex.mp4, inverse.mp4" } else { " (no ffmpeg: no videos)" },
+        if has_videos { ", cortex.mp4, inverse.mp4" } else { " (no ffmpeg: no videos)" },
         a.out.display()
     );
     Ok(())

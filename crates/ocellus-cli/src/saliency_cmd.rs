@@ -32,6 +32,10 @@ pub struct SaliencyArgs {
     /// Print the effective configuration as TOML and exit (no images are read).
     #[arg(long, conflicts_with_all = ["images", "conspicuity", "timings", "out"])]
     pub print_config: bool,
+    /// Worker threads over the images (each with its own engine); 0: one per core. Results
+    /// and the order of the printed lines do not depend on it. Range: 0..=256.
+    #[arg(long, default_value_t = 0, value_parser = crate::ranges::within(0usize, 256))]
+    pub workers: usize,
 }
 
 /// What one image produced.
@@ -111,38 +115,55 @@ pub fn run(a: SaliencyArgs) -> Result<()> {
     } else {
         ProgressBar::hidden()
     };
-    let mut engine = None;
     let mut failed = 0;
-    for f in &files {
-        bar.set_message(inputs::stem(f));
-        match process_one(f, &cfg, &mut engine, &a.out, a.conspicuity) {
-            Ok(r) => {
-                bar.suspend(|| -> Result<()> {
-                    outln!(
-                        "{}: map {}x{}, most salient at ({:.1}, {:.1}) px",
-                        f.display(),
-                        r.map_size.0,
-                        r.map_size.1,
-                        r.peak_px[0],
-                        r.peak_px[1]
-                    );
-                    if a.timings {
-                        if let Some(e) = &engine {
-                            let t = e.timings();
-                            let parts: Vec<String> =
-                                t.stages().iter().map(|(n, d)| format!("{n} {:.3}", d.as_secs_f64() * 1e3)).collect();
-                            outln!("  timings ms: {}; total {:.3}", parts.join(", "), t.total().as_secs_f64() * 1e3);
+    // The images through the ordered pipeline: read and processed on the workers, reported
+    // here in the order given. A failing image is reported and counted, the others go on.
+    let mut next = files.iter();
+    let r = ocellus_io::pipeline::run_ordered(
+        ocellus_io::pipeline::PipelineConfig::with_workers(a.workers),
+        move || -> Result<Option<&PathBuf>> { Ok(next.next()) },
+        || Ok(None::<SaliencyEngine>),
+        |engine, _, f| {
+            let r = process_one(f, &cfg, engine, &a.out, a.conspicuity);
+            let timings = engine.as_ref().map(|e| {
+                let t = e.timings();
+                let parts: Vec<String> =
+                    t.stages().iter().map(|(n, d)| format!("{n} {:.3}", d.as_secs_f64() * 1e3)).collect();
+                format!("  timings ms: {}; total {:.3}", parts.join(", "), t.total().as_secs_f64() * 1e3)
+            });
+            Ok((f, r, timings))
+        },
+        |_, (f, r, timings)| {
+            bar.set_message(inputs::stem(f));
+            match r {
+                Ok(r) => {
+                    bar.suspend(|| {
+                        outln!(
+                            "{}: map {}x{}, most salient at ({:.1}, {:.1}) px",
+                            f.display(),
+                            r.map_size.0,
+                            r.map_size.1,
+                            r.peak_px[0],
+                            r.peak_px[1]
+                        );
+                        if let Some(t) = timings.filter(|_| a.timings) {
+                            outln!("{t}");
                         }
-                    }
-                    Ok(())
-                })?;
+                        Ok::<(), anyhow::Error>(())
+                    })?;
+                }
+                Err(e) => {
+                    failed += 1;
+                    bar.suspend(|| errln!("error: {e:#}"));
+                }
             }
-            Err(e) => {
-                failed += 1;
-                bar.suspend(|| errln!("error: {e:#}"));
-            }
-        }
-        bar.inc(1);
+            bar.inc(1);
+            Ok(())
+        },
+    );
+    if let Err(e) = crate::frames::pipeline_result(r) {
+        bar.finish_and_clear();
+        return Err(e);
     }
     bar.finish_and_clear();
     if failed < files.len() {

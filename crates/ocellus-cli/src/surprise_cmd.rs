@@ -1,14 +1,18 @@
-//! `ocellus surprise`: Bayesian surprise maps of a video or image sequence.
+//! `ocellus surprise`: Bayesian surprise maps of a video or image sequence, through the
+//! ordered frame pipeline (saliency on workers, surprise in order, maps written on workers).
 
 use crate::attend::StreamOptions;
 use crate::frames;
 use anyhow::{bail, Result};
 use clap::Args;
-use ocellus_attention::stream::StreamEngine;
+use ocellus_attention::stream::{StreamEngine, StreamWorker};
 use ocellus_image::colormap::overlay_scaled;
+use ocellus_image::convert::RgbImage;
 use ocellus_image::draw::half_size;
+use ocellus_image::Plane;
 use std::io::Write;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Arguments of `ocellus surprise`.
 #[derive(Args, Debug)]
@@ -26,6 +30,10 @@ pub struct SurpriseArgs {
     /// Process at most N frames. Range: 1..=10000000.
     #[arg(long, value_parser = crate::ranges::within(1usize, 10_000_000))]
     pub limit: Option<usize>,
+    /// Worker threads for saliency and for writing the maps; 0: one per core. The results do
+    /// not depend on it. Range: 0..=256.
+    #[arg(long, default_value_t = 0, value_parser = crate::ranges::within(0usize, 256))]
+    pub workers: usize,
 }
 
 /// Runs the subcommand.
@@ -41,30 +49,53 @@ pub fn run(a: SurpriseArgs) -> Result<()> {
     writeln!(csv, "frame,surprise_max_bits,x,y,chaos_bits")?;
     let mut engine: Option<StreamEngine> = None;
     let mut peak = (0.0f32, 0usize);
-    let result = frames::for_each_frame(&a.input, a.limit, |k, frame| {
-        let (w, h) = frame.size();
-        if engine.is_none() {
-            engine = Some(StreamEngine::new(cfg.clone(), w, h)?);
-        }
-        let Some(e) = engine.as_mut() else { bail!("no engine") };
-        let r = e.process(frame, 0.0, 0.0)?;
-        let m = r.surprise;
-        let Some(p) = ocellus_image::location::peak(m, (w, h)) else { bail!("frame {k}: empty surprise map") };
-        let (best, [px, py]) = (p.value, p.pixel);
-        let chaos = r.chaos.map(|c| format!("{c:.5}")).unwrap_or_default();
-        writeln!(csv, "{k},{best:.4},{px:.1},{py:.1},{chaos}")?;
-        if best > peak.0 {
-            peak = (best, k);
-        }
-        let img = overlay_scaled(ocellus_image::Backend::Auto, &half_size(&frame.to_u8()), m, 10.0)?;
-        ocellus_io::write_png(maps.join(format!("frame_{k:05}.png")), &img)?;
-        if a.npy {
-            ocellus_io::npy::write_plane(maps.join(format!("frame_{k:05}.npy")), m)?;
-        }
-        Ok(())
-    });
+    // Saliency on the workers, surprise in frame order here, the maps written by the writers.
+    let (result, written) = frames::with_ordered_writer(
+        a.workers,
+        |k, (frame, m): (Arc<RgbImage>, Plane<f32>)| -> Result<()> {
+            let img = overlay_scaled(ocellus_image::Backend::Auto, &half_size(&frame.to_u8()), &m, 10.0)?;
+            ocellus_io::write_png(maps.join(format!("frame_{k:05}.png")), &img)?;
+            if a.npy {
+                ocellus_io::npy::write_plane(maps.join(format!("frame_{k:05}.npy")), &m)?;
+            }
+            Ok(())
+        },
+        |_, ()| Ok(()),
+        |jobs| {
+            frames::for_each_frame_parallel(
+                &a.input,
+                a.limit,
+                a.workers,
+                |w, h| Ok(StreamWorker::new(&cfg, w, h)?),
+                |worker, k, pair| Ok((worker.process(k, &pair.cur, pair.prev.as_deref())?, pair.cur)),
+                |k, (maps, frame)| {
+                    let (w, h) = frame.size();
+                    let e = match engine.as_mut() {
+                        Some(e) => e,
+                        None => engine.insert(StreamEngine::new(cfg.clone(), w, h)?),
+                    };
+                    let r = e.process_maps(maps, 0.0, 0.0)?;
+                    let m = r.surprise;
+                    let Some(p) = ocellus_image::location::peak(m, (w, h)) else {
+                        bail!("frame {k}: empty surprise map")
+                    };
+                    let (best, [px, py]) = (p.value, p.pixel);
+                    let chaos = r.chaos.map(|c| format!("{c:.5}")).unwrap_or_default();
+                    writeln!(csv, "{k},{best:.4},{px:.1},{py:.1},{chaos}")?;
+                    if best > peak.0 {
+                        peak = (best, k);
+                    }
+                    if jobs.send((frame, m.clone())).is_err() {
+                        bail!("the map writer stopped");
+                    }
+                    Ok(())
+                },
+            )
+        },
+    );
     csv.flush()?;
     let n = result?;
+    written?;
     outln!(
         "{n} frames; largest surprise {:.2} bits at frame {}; wrote surprise/ and surprise.csv in {}",
         peak.0,
