@@ -333,6 +333,36 @@ fn attend_gives_the_same_results_at_any_number_of_workers() {
 }
 
 #[test]
+fn surprise_and_saliency_give_the_same_files_at_any_number_of_workers() {
+    let dir = tmpdir("workers-files");
+    let seq = dir.join("seq");
+    generate(&seq, "sudden", 9, 5, false);
+    let run = |cmd: &[&str], workers: &str| {
+        let out = dir.join(format!("{}{workers}", cmd[0]));
+        let o = ocellus()
+            .args(cmd)
+            .arg(seq.join("frames"))
+            .args(["--workers", workers, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        out
+    };
+    let (s1, s2) = (run(&["surprise", "--npy"], "1"), run(&["surprise", "--npy"], "2"));
+    assert_eq!(std::fs::read(s1.join("surprise.csv")).unwrap(), std::fs::read(s2.join("surprise.csv")).unwrap());
+    for k in 0..9 {
+        let f = format!("surprise/frame_{k:05}.npy");
+        assert_eq!(std::fs::read(s1.join(&f)).unwrap(), std::fs::read(s2.join(&f)).unwrap(), "{f}");
+    }
+    let (m1, m3) = (run(&["saliency"], "1"), run(&["saliency"], "3"));
+    for k in 0..9 {
+        let f = format!("frame_{k:05}.saliency.npy");
+        assert_eq!(std::fs::read(m1.join(&f)).unwrap(), std::fs::read(m3.join(&f)).unwrap(), "{f}");
+    }
+}
+
+#[test]
 fn attend_on_a_cut_video_keeps_the_frames_before_and_names_the_frame() {
     let dir = tmpdir("attend-cut");
     let seq = dir.join("seq");
