@@ -17,6 +17,18 @@ fn round_non_negative(v: f32) -> f32 {
     (v + 0.5) as i32 as f32
 }
 
+/// [`round_non_negative`] as the build computes it best: where the CPU has a rounding
+/// instruction (the AVX2 builds) `floor(v + 0.5)`, which vectorizes; elsewhere the
+/// truncating conversion. The two agree for every `v >= 0` below 2^31.
+#[inline(always)]
+fn round_up_half<M: Madd>(v: f32) -> f32 {
+    if M::AVX2 {
+        (v + 0.5).floor()
+    } else {
+        round_non_negative(v)
+    }
+}
+
 /// The colour at `t` already clamped to [0, 1], channels in [0, 255] before rounding.
 #[inline(always)]
 fn heat_unrounded(t: f32) -> [f32; 3] {
@@ -61,36 +73,45 @@ fn overlay_with_scale(backend: Backend, img: &Plane<[u8; 3]>, map: &Plane<f32>, 
 
 /// One row of [`overlay_with_scale`]; pixels past the end of `map` blend a map value of 0.
 /// The colour map is evaluated as a sum of clamped ramps, one per segment, rather than by
-/// looking up the segment: no table index, no libm call (see [`round_non_negative`]), so the
-/// loop vectorizes. An overlay video of a 640x480 stream blends three such panels per frame.
+/// looking up the segment, and the arithmetic runs on chunks of planar scratch arrays: no
+/// table index, no libm call (see [`round_non_negative`]) and no interleaved bytes in the hot
+/// loops, so they vectorize. An overlay video of a 640x480 stream blends three such panels
+/// per frame.
 #[inline(always)]
 fn overlay_row_generic<M: Madd>(img: &[[u8; 3]], map: &[f32], s: f32, out: &mut [[u8; 3]]) {
     const SEGMENTS: usize = STOPS.len() - 1;
+    const C: usize = 64;
     let rise: [[f32; 3]; SEGMENTS] =
         std::array::from_fn(|j| [0, 1, 2].map(|k| (STOPS[j + 1][k] - STOPS[j][k]) * 255.0));
     let base = STOPS[0].map(|v| v * 255.0);
     let n = out.len().min(img.len());
-    let m = map.len().min(n);
-    let blend = |p: &[u8; 3], v: f32| -> [u8; 3] {
-        let grey = luma(p.map(f32::from)) * 0.6;
-        // NaN compares false and becomes 0, as in heat_color.
-        let t = if v * s > 0.0 { (v * s).min(1.0) } else { 0.0 };
-        let u = t * SEGMENTS as f32;
-        let mut c = base;
-        for (j, r) in rise.iter().enumerate() {
-            let f = (u - j as f32).clamp(0.0, 1.0);
-            for k in 0..3 {
-                c[k] = M::madd(f, r[k], c[k]);
+    let mut x0 = 0;
+    while x0 < n {
+        let len = C.min(n - x0);
+        let (mut grey, mut t) = ([0f32; C], [0f32; C]);
+        for i in 0..len {
+            let p = img[x0 + i].map(f32::from);
+            grey[i] = luma(p) * 0.6;
+            let v = map.get(x0 + i).copied().unwrap_or(0.0) * s;
+            // NaN compares false and becomes 0, as in heat_color.
+            t[i] = if v > 0.0 { v.min(1.0) } else { 0.0 };
+        }
+        let mut planes = [[0f32; C]; 3];
+        for (k, plane) in planes.iter_mut().enumerate() {
+            for i in 0..C {
+                let u = t[i] * SEGMENTS as f32;
+                let mut c = base[k];
+                for (j, r) in rise.iter().enumerate() {
+                    c = M::madd((u - j as f32).clamp(0.0, 1.0), r[k], c);
+                }
+                let a = 0.25 + 0.6 * t[i];
+                plane[i] = round_up_half::<M>(grey[i] * (1.0 - a) + round_up_half::<M>(c) * a).min(255.0);
             }
         }
-        let a = 0.25 + 0.6 * t;
-        [0, 1, 2].map(|k| round_non_negative(grey * (1.0 - a) + round_non_negative(c[k]) * a).min(255.0) as u8)
-    };
-    for ((o, p), &v) in out[..m].iter_mut().zip(&img[..m]).zip(&map[..m]) {
-        *o = blend(p, v);
-    }
-    for (o, p) in out[m..n].iter_mut().zip(&img[m..n]) {
-        *o = blend(p, 0.0);
+        for (i, o) in out[x0..x0 + len].iter_mut().enumerate() {
+            *o = [planes[0][i] as u8, planes[1][i] as u8, planes[2][i] as u8];
+        }
+        x0 += len;
     }
 }
 
