@@ -72,17 +72,53 @@ pub fn grid2x2(panels: [&Plane<[u8; 3]>; 4]) -> Plane<[u8; 3]> {
 /// (p - 0.5) / 2 in it.
 pub fn half_size(img: &Plane<[u8; 3]>) -> Plane<[u8; 3]> {
     let (w, h) = (img.width() / 2, img.height() / 2);
-    Plane::from_fn(w.max(1), h.max(1), |x, y| {
-        let (x0, y0) = ((2 * x).min(img.width() - 1), (2 * y).min(img.height() - 1));
-        let (x1, y1) = ((x0 + 1).min(img.width() - 1), (y0 + 1).min(img.height() - 1));
-        let p = [img.get(x0, y0), img.get(x1, y0), img.get(x0, y1), img.get(x1, y1)];
-        [0, 1, 2].map(|k| ((p.iter().map(|q| q[k] as u32).sum::<u32>() + 2) / 4) as u8)
-    })
+    if w == 0 || h == 0 {
+        // A 1-pixel-wide or -high image: its first pixel(s), clamped as the 2x2 rule reads them.
+        return Plane::from_fn(w.max(1), h.max(1), |x, y| {
+            let (x0, y0) = ((2 * x).min(img.width() - 1), (2 * y).min(img.height() - 1));
+            let (x1, y1) = ((x0 + 1).min(img.width() - 1), (y0 + 1).min(img.height() - 1));
+            let p = [img.get(x0, y0), img.get(x1, y0), img.get(x0, y1), img.get(x1, y1)];
+            [0, 1, 2].map(|k| ((p.iter().map(|q| q[k] as u32).sum::<u32>() + 2) / 4) as u8)
+        });
+    }
+    let mut out = Plane::new(w, h);
+    for y in 0..h {
+        // Row pairs as flat bytes: the loop is plain arithmetic on slices.
+        let (a, b) = (img.row(2 * y).as_flattened(), img.row(2 * y + 1).as_flattened());
+        let o = out.row_mut(y).as_flattened_mut();
+        for (x, o) in o.chunks_exact_mut(3).enumerate() {
+            let (pa, pb) = (&a[6 * x..6 * x + 6], &b[6 * x..6 * x + 6]);
+            for k in 0..3 {
+                let sum = pa[k] as u32 + pa[k + 3] as u32 + pb[k] as u32 + pb[k + 3] as u32;
+                o[k] = ((sum + 2) / 4) as u8;
+            }
+        }
+    }
+    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn half_size_is_the_rounded_mean_of_each_2x2_block() {
+        for (w, h) in [(7, 5), (1, 4), (6, 1), (1, 1), (8, 6)] {
+            let img = Plane::from_fn(w, h, |x, y| [(x * 37 + y * 11) as u8, (x * y * 5) as u8, 255 - (x + y) as u8]);
+            let half = half_size(&img);
+            assert_eq!(half.size(), ((w / 2).max(1), (h / 2).max(1)));
+            for y in 0..half.height() {
+                for x in 0..half.width() {
+                    let at = |dx: usize, dy: usize| img.get((2 * x + dx).min(w - 1), (2 * y + dy).min(h - 1));
+                    let want = [0, 1, 2].map(|k| {
+                        let s: u32 = [at(0, 0), at(1, 0), at(0, 1), at(1, 1)].iter().map(|p| p[k] as u32).sum();
+                        (s as f64 / 4.0).round() as u8
+                    });
+                    assert_eq!(half.get(x, y), want, "{w}x{h} at ({x}, {y})");
+                }
+            }
+        }
+    }
 
     #[test]
     fn the_grid_places_each_panel_in_its_quarter() {
