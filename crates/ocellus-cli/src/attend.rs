@@ -5,7 +5,7 @@ use crate::{config_file, frames, plot, ranges};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ocellus_attention::attention::{Fixation, Reason};
-use ocellus_attention::stream::{StreamConfig, StreamEngine, StreamFrame, StreamWorker};
+use ocellus_attention::stream::{FrameMaps, StreamConfig, StreamEngine, StreamFrame, StreamWorker};
 use ocellus_attention::surprise::SurpriseConfig;
 use ocellus_image::colormap::overlay_scaled;
 use ocellus_image::convert::RgbImage;
@@ -242,6 +242,34 @@ fn composite(r: &RenderJob) -> Result<Plane<[u8; 3]>> {
     Ok(draw::grid2x2([&view, &sal, &sur, &inh]))
 }
 
+/// The stream of `input` (at most `limit` frames) on `workers` threads (0: one per core):
+/// saliency on the workers (`StreamWorker`), then `f(k, engine, maps, frame)` here in frame
+/// order with one `StreamEngine` (made for the first frame's size) for the sequential part.
+pub fn stream_frames(
+    input: &Path,
+    limit: Option<usize>,
+    workers: usize,
+    cfg: &StreamConfig,
+    mut f: impl FnMut(usize, &mut StreamEngine, FrameMaps, Arc<RgbImage>) -> Result<()>,
+) -> Result<usize> {
+    let mut engine: Option<StreamEngine> = None;
+    frames::for_each_frame_parallel(
+        input,
+        limit,
+        workers,
+        |w, h| Ok(StreamWorker::new(cfg, w, h)?),
+        |worker, k, pair| Ok((worker.process(k, &pair.cur, pair.prev.as_deref())?, pair.cur)),
+        |k, (maps, frame)| {
+            let (w, h) = frame.size();
+            let e = match engine.as_mut() {
+                Some(e) => e,
+                None => engine.insert(StreamEngine::new(cfg.clone(), w, h)?),
+            };
+            f(k, e, maps, frame)
+        },
+    )
+}
+
 /// Runs the subcommand.
 pub fn run(a: AttendArgs) -> Result<()> {
     let out = a.out.clone();
@@ -264,7 +292,6 @@ pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
         crate::inputs::check_out_dir(&d, std::slice::from_ref(&a.input))?;
     }
     let mut out = Outputs::new(&a.out, !a.no_overlays)?;
-    let mut engine: Option<StreamEngine> = None;
     let threshold = cfg.chaos.threshold;
     let png_dir = (!a.no_overlays).then(|| a.out.join("overlays"));
     let workers = a.workers;
@@ -294,30 +321,18 @@ pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
             Ok(())
         },
         |jobs| {
-            frames::for_each_frame_parallel(
-                &a.input,
-                a.limit,
-                workers,
-                |w, h| Ok(StreamWorker::new(&cfg, w, h)?),
-                |worker, k, pair| Ok((worker.process(k, &pair.cur, pair.prev.as_deref())?, pair.cur)),
-                |k, (maps, frame)| {
-                    let (w, h) = frame.size();
-                    let e = match engine.as_mut() {
-                        Some(e) => e,
-                        None => engine.insert(StreamEngine::new(cfg.clone(), w, h)?),
-                    };
-                    let (pan, tilt) = match &pan_tilt {
-                        Some(v) => *v.get(k).with_context(|| format!("the pan-tilt CSV has no row for frame {k}"))?,
-                        None => (0.0, 0.0),
-                    };
-                    let r = e.process_maps(maps, pan, tilt)?;
-                    let job = out.record(frame, &r, draw)?;
-                    if job.is_some_and(|j| jobs.send(j).is_err()) {
-                        bail!("the overlay writer stopped");
-                    }
-                    Ok(())
-                },
-            )
+            stream_frames(&a.input, a.limit, workers, &cfg, |k, e, maps, frame| {
+                let (pan, tilt) = match &pan_tilt {
+                    Some(v) => *v.get(k).with_context(|| format!("the pan-tilt CSV has no row for frame {k}"))?,
+                    None => (0.0, 0.0),
+                };
+                let r = e.process_maps(maps, pan, tilt)?;
+                let job = out.record(frame, &r, draw)?;
+                if job.is_some_and(|j| jobs.send(j).is_err()) {
+                    bail!("the overlay writer stopped");
+                }
+                Ok(())
+            })
         },
     );
     let wrote_video = video.is_some();

@@ -1,11 +1,10 @@
 //! `ocellus surprise`: Bayesian surprise maps of a video or image sequence, through the
 //! ordered frame pipeline (saliency on workers, surprise in order, maps written on workers).
 
-use crate::attend::StreamOptions;
+use crate::attend::{stream_frames, StreamOptions};
 use crate::frames;
 use anyhow::{bail, Result};
 use clap::Args;
-use ocellus_attention::stream::{StreamEngine, StreamWorker};
 use ocellus_image::colormap::overlay_scaled;
 use ocellus_image::convert::RgbImage;
 use ocellus_image::draw::half_size;
@@ -47,7 +46,6 @@ pub fn run(a: SurpriseArgs) -> Result<()> {
     let csv_path = a.out.join("surprise.csv");
     let mut csv = crate::output_files::create_file(&csv_path)?;
     writeln!(csv, "frame,surprise_max_bits,x,y,chaos_bits")?;
-    let mut engine: Option<StreamEngine> = None;
     let mut peak = (0.0f32, 0usize);
     // Saliency on the workers, surprise in frame order here, the maps written by the writers.
     let (result, written) = frames::with_ordered_writer(
@@ -62,35 +60,22 @@ pub fn run(a: SurpriseArgs) -> Result<()> {
         },
         |_, ()| Ok(()),
         |jobs| {
-            frames::for_each_frame_parallel(
-                &a.input,
-                a.limit,
-                a.workers,
-                |w, h| Ok(StreamWorker::new(&cfg, w, h)?),
-                |worker, k, pair| Ok((worker.process(k, &pair.cur, pair.prev.as_deref())?, pair.cur)),
-                |k, (maps, frame)| {
-                    let (w, h) = frame.size();
-                    let e = match engine.as_mut() {
-                        Some(e) => e,
-                        None => engine.insert(StreamEngine::new(cfg.clone(), w, h)?),
-                    };
-                    let r = e.process_maps(maps, 0.0, 0.0)?;
-                    let m = r.surprise;
-                    let Some(p) = ocellus_image::location::peak(m, (w, h)) else {
-                        bail!("frame {k}: empty surprise map")
-                    };
-                    let (best, [px, py]) = (p.value, p.pixel);
-                    let chaos = r.chaos.map(|c| format!("{c:.5}")).unwrap_or_default();
-                    writeln!(csv, "{k},{best:.4},{px:.1},{py:.1},{chaos}")?;
-                    if best > peak.0 {
-                        peak = (best, k);
-                    }
-                    if jobs.send((frame, m.clone())).is_err() {
-                        bail!("the map writer stopped");
-                    }
-                    Ok(())
-                },
-            )
+            stream_frames(&a.input, a.limit, a.workers, &cfg, |k, e, maps, frame| {
+                let (w, h) = frame.size();
+                let r = e.process_maps(maps, 0.0, 0.0)?;
+                let m = r.surprise;
+                let Some(p) = ocellus_image::location::peak(m, (w, h)) else { bail!("frame {k}: empty surprise map") };
+                let (best, [px, py]) = (p.value, p.pixel);
+                let chaos = r.chaos.map(|c| format!("{c:.5}")).unwrap_or_default();
+                writeln!(csv, "{k},{best:.4},{px:.1},{py:.1},{chaos}")?;
+                if best > peak.0 {
+                    peak = (best, k);
+                }
+                if jobs.send((frame, m.clone())).is_err() {
+                    bail!("the map writer stopped");
+                }
+                Ok(())
+            })
         },
     );
     csv.flush()?;
