@@ -340,7 +340,9 @@ pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
     // Whatever happened, what was processed is written out.
     let saccades = out.saccades;
     let written = out.finish(threshold, wrote_video && rendered.is_ok())?;
-    let n = result?;
+    // A writer that failed first makes the stream stop with "writer stopped": its own error
+    // is the one to report.
     rendered?;
+    let n = result?;
     Ok((n, saccades, written))
 }

@@ -79,8 +79,9 @@ pub fn run(a: SurpriseArgs) -> Result<()> {
         },
     );
     csv.flush()?;
-    let n = result?;
+    // The writers' own error first: the stream stops with "writer stopped" after it.
     written?;
+    let n = result?;
     outln!(
         "{n} frames; largest surprise {:.2} bits at frame {}; wrote surprise/ and surprise.csv in {}",
         peak.0,
