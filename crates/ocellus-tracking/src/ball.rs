@@ -6,16 +6,17 @@
 //! particle moves by [`MotionModel`] or, boosted, is drawn from a bottom-up detection
 //! (SPEC 7.4), and is weighed by the colour likelihood of the ball's image circle.
 
-use crate::colour::{BinnedFrame, Circle, ColourModel};
+use crate::colour::{union_rect, BinnedFrame, Circle, ColourModel};
 use crate::detection::BallDetection;
 use crate::motion::{log_add, MotionModel};
 use crate::{Result, TrackingError};
 use nalgebra::Vector3;
-use ocellus_estimation::particle_filter::{Draw, Model};
+use ocellus_estimation::particle_filter::{Draw, Model, ParticleFilter, StepReport};
 use ocellus_geometry::camera::PinholeCamera;
 use ocellus_geometry::distortion::Distortion;
 use ocellus_geometry::sphere::project_sphere;
 use ocellus_image::rng::SplitMix64;
+use ocellus_image::Plane;
 use rayon::prelude::*;
 
 /// A ball hypothesis: centre and velocity in the world frame.
@@ -131,16 +132,24 @@ impl BallModel {
     /// ([`BinnedFrame::update_region`]) gives the same scores as binning the frame. Empty
     /// when no state is in view.
     pub fn samples_region(&self, states: &[BallState], w: usize, h: usize) -> [usize; 4] {
-        let union = |a: [usize; 4], b: [usize; 4]| {
-            if a[0] >= a[2] || a[1] >= a[3] {
-                b
-            } else if b[0] >= b[2] || b[1] >= b[3] {
-                a
-            } else {
-                [a[0].min(b[0]), a[1].min(b[1]), a[2].max(b[2]), a[3].max(b[3])]
-            }
-        };
-        states.par_iter().map(|s| self.circle(s).map_or([0; 4], |c| c.samples_rect(w, h))).reduce(|| [0; 4], union)
+        states.par_iter().map(|s| self.circle(s).map_or([0; 4], |c| c.samples_rect(w, h))).reduce(|| [0; 4], union_rect)
+    }
+
+    /// One step of a filter without detections (the plain SIR/SIS, `boost = 0`): moves the
+    /// particles, bins only the region their circles read into `obs`
+    /// ([`Self::samples_region`]; the scores are those of the whole frame binned), then weighs
+    /// and resamples. `obs.detections` is cleared.
+    pub fn step_in_region(
+        &self,
+        filter: &mut ParticleFilter<BallState>,
+        frame: &Plane<[u8; 3]>,
+        obs: &mut BallFrame,
+    ) -> Result<StepReport> {
+        obs.detections.clear();
+        filter.propose(self, obs);
+        let (w, h) = frame.size();
+        obs.binned.update_region(frame, self.samples_region(filter.particles(), w, h));
+        Ok(filter.weigh_proposed(self, obs)?)
     }
 }
 
@@ -191,7 +200,6 @@ mod tests {
     use crate::motion::MotionModel;
     use nalgebra::Matrix3;
     use ocellus_geometry::camera::Intrinsics;
-    use ocellus_image::Plane;
 
     #[test]
     fn binning_only_the_particles_region_gives_the_scores_of_the_whole_frame() {

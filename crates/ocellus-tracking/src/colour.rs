@@ -192,6 +192,32 @@ impl BinnedFrame {
         self.region = region;
     }
 
+    /// Grows the binned region to also hold `rect` (clamped to the frame), binning only the
+    /// pixels it adds; `frame` must be the frame binned last.
+    pub fn extend_region(&mut self, frame: &Plane<[u8; 3]>, rect: [usize; 4]) {
+        let (w, h) = frame.size();
+        let old = self.region;
+        let [x0, y0, x1, y1] = union_rect(old, [rect[0], rect[1], rect[2].min(w), rect[3].min(h)]);
+        if [x0, y0, x1, y1] == old {
+            return;
+        }
+        if old[0] >= old[2] || old[1] >= old[3] || self.bins.size() != (w, h) {
+            self.update_region(frame, [x0, y0, x1, y1]);
+            return;
+        }
+        // The union minus the old rectangle: full-width bands above and below it, and the
+        // parts left and right of it in its rows.
+        let backend = Backend::Auto;
+        for band in
+            [[x0, y0, x1, old[1]], [x0, old[3], x1, y1], [x0, old[1], old[0], old[3]], [old[2], old[1], x1, old[3]]]
+        {
+            if band[0] < band[2] && band[1] < band[3] {
+                bin_rect(backend, frame, &mut self.bins, band);
+            }
+        }
+        self.region = [x0, y0, x1, y1];
+    }
+
     /// The bins, one per pixel; valid inside [`Self::region`] only.
     pub fn bins(&self) -> &Plane<u8> {
         &self.bins
@@ -212,6 +238,19 @@ impl BinnedFrame {
         } else {
             None
         }
+    }
+}
+
+/// The smallest rectangle [x0, y0, x1, y1) holding both `a` and `b` (an empty one, with
+/// x0 >= x1 or y0 >= y1, adds nothing).
+pub fn union_rect(a: [usize; 4], b: [usize; 4]) -> [usize; 4] {
+    let empty = |r: [usize; 4]| r[0] >= r[2] || r[1] >= r[3];
+    if empty(a) {
+        b
+    } else if empty(b) {
+        a
+    } else {
+        [a[0].min(b[0]), a[1].min(b[1]), a[2].max(b[2]), a[3].max(b[3])]
     }
 }
 
@@ -478,6 +517,25 @@ mod tests {
         assert!(bin_of([250, 224, 224]) < 100);
         assert_eq!(bin_of([51, 0, 0]), 102, "V = 0.2 exactly is a value bin");
         assert_eq!(bin_of([52, 0, 0]), 9);
+    }
+
+    #[test]
+    fn extending_the_region_bins_what_the_union_adds() {
+        let frame = Plane::from_fn(40, 30, |x, y| [(x * 6) as u8, (y * 8) as u8, ((x + y) * 3) as u8]);
+        let whole = BinnedFrame::new(&frame);
+        for (a, b) in [([5, 6, 20, 18], [15, 2, 38, 25]), ([5, 6, 20, 18], [8, 8, 12, 12]), ([0; 4], [3, 4, 9, 9])] {
+            let mut part = BinnedFrame::default();
+            part.update_region(&frame, a);
+            part.extend_region(&frame, b);
+            let u = union_rect(a, b);
+            assert_eq!(part.region(), u);
+            for y in u[1]..u[3] {
+                for x in u[0]..u[2] {
+                    assert_eq!(part.bins().get(x, y), whole.bins().get(x, y), "({x}, {y}) of {u:?}");
+                }
+            }
+        }
+        assert_eq!(union_rect([2, 2, 2, 9], [1, 1, 3, 3]), [1, 1, 3, 3]);
     }
 
     #[test]

@@ -189,13 +189,7 @@ impl BallTracker {
             // The plain filter reads the frame only through its particles' circles: the
             // particles move first, and only the part of the frame they can see is binned
             // (their scores are those of the whole frame binned); detection is skipped.
-            Some(f) if plain => {
-                self.obs.detections.clear();
-                f.propose(&self.model, &self.obs);
-                let region = self.model.samples_region(f.particles(), w, h);
-                self.obs.binned.update_region(frame, region);
-                f.weigh_proposed(&self.model, &self.obs)?.ess
-            }
+            Some(f) if plain => self.model.step_in_region(f, frame, &mut self.obs)?.ess,
             _ => self.detect_and_step(frame)?,
         };
         let n_det = self.obs.detections.len();
@@ -216,11 +210,7 @@ impl BallTracker {
         let circle = self.model.circle(&BallState { position, velocity });
         if let Some(c) = circle {
             // The mean's circle may reach past the particles' region: bin what it adds.
-            let [a, b] = [self.obs.binned.region(), c.samples_rect(w, h)];
-            if b[0] < b[2] && b[1] < b[3] && (b[0] < a[0] || b[1] < a[1] || b[2] > a[2] || b[3] > a[3]) {
-                let union = [a[0].min(b[0]), a[1].min(b[1]), a[2].max(b[2]), a[3].max(b[3])];
-                self.obs.binned.update_region(frame, union);
-            }
+            self.obs.binned.extend_region(frame, c.samples_rect(w, h));
         }
         let score = circle.map_or(-1.0, |c| self.model.colour.score(&self.obs.binned, c));
         Ok(TrackEstimate {

@@ -79,11 +79,7 @@ fn sir_step_ms(
                 obs.binned.update(frame);
                 pf.step(model, &obs)?;
             } else {
-                pf.propose(model, &obs);
-                let (w, h) = frame.size();
-                let region = model.samples_region(pf.particles(), w, h);
-                obs.binned.update_region(frame, region);
-                pf.weigh_proposed(model, &obs)?;
+                model.step_in_region(&mut pf, frame, &mut obs)?;
             }
             t.push(s.elapsed().as_secs_f64() * 1e3);
         }
