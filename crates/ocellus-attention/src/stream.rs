@@ -239,7 +239,6 @@ impl StreamEngine {
     /// frame count stay.
     pub fn reset_temporal(&mut self) {
         self.worker.saliency.reset_temporal();
-        self.worker.last = None;
         self.surprise.reset();
         self.chaos.reset();
     }
@@ -247,10 +246,9 @@ impl StreamEngine {
     /// Processes one frame seen by a camera at (`pan_deg`, `tilt_deg`).
     pub fn process(&mut self, frame: &RgbImage, pan_deg: f32, tilt_deg: f32) -> Result<StreamFrame<'_>> {
         let k = self.frame;
-        // After reset_temporal the worker starts afresh: the next frame has no flicker.
-        if self.worker.last.is_none() && k > 0 {
-            self.worker.last = Some(k - 1);
-        }
+        // Every frame of this engine goes through its own worker in order, so the worker's
+        // flicker memory is that of the frame before (or empty after reset_temporal).
+        self.worker.last = k.checked_sub(1);
         let mut maps = std::mem::take(&mut self.maps);
         let r = self.worker.process_into(k, frame, None, &mut maps);
         self.maps = maps;

@@ -500,7 +500,7 @@ fn write_outputs(out: &Path, su: &Setup<f32>, runs: &[Run], best: usize, layout:
         )?;
     }
     let colours = [RGBColor(30, 90, 200), RGBColor(220, 80, 20)];
-    let best =
+    let lowest =
         runs.iter().filter_map(|r| r.state.history.last().map(|h| h.cost)).fold(f64::INFINITY, f64::min).max(1e-12);
     let series: Vec<Series> = runs
         .iter()
@@ -524,7 +524,7 @@ fn write_outputs(out: &Path, su: &Setup<f32>, runs: &[Run], best: usize, layout:
             series: &series,
             threshold: None,
             // The first iterations fall by an order of magnitude; show the part that differs.
-            y_range: Some((0.0, 4.0 * best)),
+            y_range: Some((0.0, 4.0 * lowest)),
         },
     )?;
     Ok(())

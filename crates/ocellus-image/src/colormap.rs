@@ -29,21 +29,25 @@ fn round_up_half<M: Madd>(v: f32) -> f32 {
     }
 }
 
-/// The colour at `t` already clamped to [0, 1], channels in [0, 255] before rounding.
+/// Channel `k` of the colour at `t` already clamped to [0, 1], in [0, 255] before rounding:
+/// the first stop plus one clamped ramp per segment. No table index, so loops over pixels
+/// vectorize; [`heat_color`] and the overlays share it.
 #[inline(always)]
-fn heat_unrounded(t: f32) -> [f32; 3] {
-    let t = t * (STOPS.len() - 1) as f32;
-    // t >= 0: truncation is the floor.
-    let i = (t as usize).min(STOPS.len() - 2);
-    let f = t - i as f32;
-    [0, 1, 2].map(|k| (STOPS[i][k] + f * (STOPS[i + 1][k] - STOPS[i][k])) * 255.0)
+fn heat_channel<M: Madd>(t: f32, k: usize) -> f32 {
+    const SEGMENTS: usize = STOPS.len() - 1;
+    let u = t * SEGMENTS as f32;
+    let mut c = STOPS[0][k] * 255.0;
+    for j in 0..SEGMENTS {
+        c = M::madd((u - j as f32).clamp(0.0, 1.0), (STOPS[j + 1][k] - STOPS[j][k]) * 255.0, c);
+    }
+    c
 }
 
 /// A perceptually ordered colour map (dark blue → cyan → yellow → red), `t` in [0, 1]
 /// (clamped; NaN gives the colour of 0).
 pub fn heat_color(t: f32) -> [u8; 3] {
     let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
-    heat_unrounded(t).map(|v| round_non_negative(v) as u8)
+    [0, 1, 2].map(|k| round_non_negative(heat_channel::<crate::simd::Plain>(t, k)) as u8)
 }
 
 /// `map` as a heat map of `map / max` (values clamped to [0, 1]); non-finite pixels black
@@ -79,11 +83,7 @@ fn overlay_with_scale(backend: Backend, img: &Plane<[u8; 3]>, map: &Plane<f32>, 
 /// per frame.
 #[inline(always)]
 fn overlay_row_generic<M: Madd>(img: &[[u8; 3]], map: &[f32], s: f32, out: &mut [[u8; 3]]) {
-    const SEGMENTS: usize = STOPS.len() - 1;
     const C: usize = 64;
-    let rise: [[f32; 3]; SEGMENTS] =
-        std::array::from_fn(|j| [0, 1, 2].map(|k| (STOPS[j + 1][k] - STOPS[j][k]) * 255.0));
-    let base = STOPS[0].map(|v| v * 255.0);
     let n = out.len().min(img.len());
     let mut x0 = 0;
     while x0 < n {
@@ -99,11 +99,7 @@ fn overlay_row_generic<M: Madd>(img: &[[u8; 3]], map: &[f32], s: f32, out: &mut 
         let mut planes = [[0f32; C]; 3];
         for (k, plane) in planes.iter_mut().enumerate() {
             for i in 0..C {
-                let u = t[i] * SEGMENTS as f32;
-                let mut c = base[k];
-                for (j, r) in rise.iter().enumerate() {
-                    c = M::madd((u - j as f32).clamp(0.0, 1.0), r[k], c);
-                }
+                let c = heat_channel::<M>(t[i], k);
                 let a = 0.25 + 0.6 * t[i];
                 plane[i] = round_up_half::<M>(grey[i] * (1.0 - a) + round_up_half::<M>(c) * a).min(255.0);
             }
