@@ -167,6 +167,9 @@ pub fn run(a: BallArgs) -> Result<()> {
         if a.lighting_change { ", lighting change" } else { "" },
         a.out.display()
     );
+    if let Some((y, e)) = trajectory.floor() {
+        outln!("the floor is at y = {y} m (restitution {e}): track with --gravity 9.81 --floor-y {y}");
+    }
     Ok(())
 }
 

@@ -16,6 +16,7 @@ use ocellus_io::video_writer::VideoWriter;
 use ocellus_sim::ball_tracking::study;
 use ocellus_synth::ball_world::Trajectory;
 use ocellus_tracking::colour::{Circle, ColourModel};
+use ocellus_tracking::motion::Floor;
 use ocellus_tracking::tracker::{BallTracker, TrackEstimate, TrackerConfig, MAX_PARTICLES};
 use plotters::style::RGBColor;
 use std::io::Write;
@@ -53,6 +54,13 @@ pub struct TrackArgs {
     /// level camera). Range: -100..=100.
     #[arg(long, default_value_t = 0.0, value_parser = ranges::within(-100.0f64, 100.0))]
     gravity: f64,
+    /// Height of a level floor the ball bounces on: camera-frame y (down) of the floor,
+    /// metres (`generate ball` prints it). Default: no floor. Range: -1000..=1000.
+    #[arg(long, value_parser = ranges::within(-1000.0f64, 1000.0))]
+    floor_y: Option<f64>,
+    /// Share of its speed into the floor that a bounce keeps (with --floor-y). Range: 0..=1.
+    #[arg(long, default_value_t = 0.8, value_parser = ranges::within(0.0f64, 1.0))]
+    restitution: f64,
     /// White acceleration noise of the motion model, m/s^2. Range: above 0, at most 1000.
     #[arg(long, default_value_t = 10.0, value_parser = ranges::above(0.0f64, 1000.0))]
     accel_sigma: f64,
@@ -191,6 +199,7 @@ pub fn run(a: TrackArgs) -> Result<()> {
     cfg.filter.seed = a.seed;
     cfg.motion.gravity = [0.0, a.gravity, 0.0];
     cfg.motion.accel_sigma = a.accel_sigma;
+    cfg.motion.floor = a.floor_y.map(|y| Floor::below(y, radius_m, a.restitution));
     crate::inputs::check_out_dir(&a.out, std::slice::from_ref(input))?;
     crate::output_files::create_dir(&a.out)?;
     if !a.no_overlays {

@@ -83,9 +83,10 @@ pub struct ParticleFilter<S> {
     particles: Vec<S>,
     log_w: Vec<f64>,
     steps: u64,
-    // Reused per step: incremental log weights, normalized weights, parents, and the next
+    // Reused per step: incremental log weights, log likelihoods, normalized weights, parents, and the next
     // generation while resampling.
     increments: Vec<f64>,
+    likelihoods: Vec<f64>,
     weights: Vec<f64>,
     parents: Vec<usize>,
     next: Vec<S>,
@@ -129,6 +130,7 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
             log_w: vec![-(n as f64).ln(); n],
             steps: 0,
             increments: Vec::new(),
+            likelihoods: Vec::new(),
             weights: Vec::new(),
             parents: Vec::new(),
             next: Vec::new(),
@@ -214,13 +216,28 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
     /// by the observation `z`, normalizes and resamples. An error when nothing was proposed
     /// since the last step.
     pub fn weigh_proposed<M: Model<State = S>>(&mut self, model: &M, z: &M::Observation) -> Result<StepReport> {
+        self.weigh_proposed_with(|particles, out| {
+            particles.par_iter().zip(out.par_iter_mut()).for_each(|(p, l)| *l = model.log_likelihood(p, z));
+        })
+    }
+
+    /// [`Self::weigh_proposed`] with the log likelihoods written by the caller:
+    /// `log_likelihoods(particles, out)` fills `out[i]` with `log p(z | particles[i])` (`out`
+    /// comes zeroed, one entry per particle). For likelihoods that look at the whole cloud
+    /// before they commit, e.g. a tracker that treats a frame where no particle sees its
+    /// target as carrying no evidence. An error when nothing was proposed since the last
+    /// step, or when an entry is NaN.
+    pub fn weigh_proposed_with(&mut self, log_likelihoods: impl FnOnce(&[S], &mut [f64])) -> Result<StepReport> {
         if !self.proposed || self.increments.len() != self.particles.len() {
             return Err(EstimationError::InvalidInput("weigh_proposed without propose".into()));
         }
         self.proposed = false;
-        self.particles.par_iter().zip(self.increments.par_iter_mut()).for_each(|(p, inc)| {
-            *inc += model.log_likelihood(p, z);
-        });
+        self.likelihoods.clear();
+        self.likelihoods.resize(self.particles.len(), 0.0);
+        log_likelihoods(&self.particles, &mut self.likelihoods);
+        for (inc, l) in self.increments.iter_mut().zip(&self.likelihoods) {
+            *inc += l;
+        }
         self.steps += 1;
         self.weigh()
     }
@@ -341,6 +358,44 @@ mod tests {
             assert_eq!(a.log_weights(), b.log_weights());
         }
         assert!(b.weigh_proposed(&model, &0.0).is_err(), "weighing twice");
+    }
+
+    #[test]
+    fn caller_written_likelihoods_add_to_the_proposal_weights() {
+        let model = Walk { step_sigma: 0.3, obs_sigma: 0.2, pull: 0.4 };
+        let cfg = FilterConfig { resample_below: 0.0, ..FilterConfig::default() };
+        let start: Vec<f64> = (0..64).map(|i| i as f64 * 0.05).collect();
+        let (mut a, mut b) =
+            (ParticleFilter::new(cfg, start.clone()).unwrap(), ParticleFilter::new(cfg, start).unwrap());
+        let z = 1.1;
+        // The same likelihoods written by the caller give the model's step bit for bit.
+        a.step(&model, &z).unwrap();
+        b.propose(&model, &z);
+        b.weigh_proposed_with(|ps, out| {
+            assert!(out.iter().all(|&l| l == 0.0), "out comes zeroed");
+            for (p, l) in ps.iter().zip(out.iter_mut()) {
+                *l = model.log_likelihood(p, &z);
+            }
+        })
+        .unwrap();
+        assert_eq!(a.log_weights(), b.log_weights());
+        // Leaving them at 0 keeps only the prior/proposal ratios: an uninformative frame.
+        let mut c = ParticleFilter::new(cfg, vec![0.0, 1.0]).unwrap();
+        c.propose(&model, &z);
+        c.weigh_proposed_with(|_, _| {}).unwrap();
+        let mut want = Vec::new();
+        for (i, prev) in [0.0f64, 1.0].iter().enumerate() {
+            let mut rng = stream(cfg.seed, 0, i as u64);
+            let centre = prev + 0.4 * (z - prev);
+            let x = centre + 0.3 * rng.normal();
+            want.push(log_normal(x, *prev, 0.3) - log_normal(x, centre, 0.3));
+        }
+        let total = (want[0].exp() + want[1].exp()).ln();
+        for (got, w) in c.log_weights().iter().zip(&want) {
+            assert!((got - (w - total)).abs() < 1e-12, "{got} vs {}", w - total);
+        }
+        c.propose(&model, &z);
+        assert!(c.weigh_proposed_with(|_, out| out[1] = f64::NAN).is_err(), "NaN is refused");
     }
 
     #[test]

@@ -13,6 +13,7 @@ use ocellus_eval::tracking::{score, EstimateFrame, TrackingScores, TruthFrame};
 use ocellus_image::Plane;
 use ocellus_synth::ball_world::{BallTruth, BallWorld, BallWorldConfig, Occlusion, Trajectory, GRAVITY};
 use ocellus_tracking::colour::{Circle, ColourModel};
+use ocellus_tracking::motion::Floor;
 use ocellus_tracking::tracker::{BallTracker, TrackEstimate, TrackerConfig};
 
 /// One tracked sequence.
@@ -36,8 +37,13 @@ pub fn model_from_first_frame(frame: &Plane<[u8; 3]>, truth: &BallTruth) -> Resu
     Ok(ColourModel::from_patch(frame, Circle { x, y, r: 0.8 * r })?)
 }
 
+/// Restitution the tracker assumes for a floor: a typical ball's, not the world's (0.75
+/// and 0.85), as a user would guess it; the motion noise covers the difference.
+pub const ASSUMED_RESTITUTION: f64 = 0.8;
+
 /// The tracker's configuration for a world: `base` with the world's frame rate and, for
-/// ballistic trajectories, gravity.
+/// ballistic trajectories, gravity and the floor's height (with [`ASSUMED_RESTITUTION`]),
+/// as a robot knows the ground it stands on.
 pub fn tracker_config(world: &BallWorldConfig, base: TrackerConfig) -> TrackerConfig {
     let mut cfg = base;
     cfg.motion.dt_s = 1.0 / world.fps;
@@ -45,6 +51,7 @@ pub fn tracker_config(world: &BallWorldConfig, base: TrackerConfig) -> TrackerCo
         Trajectory::Throw | Trajectory::Bounce => [0.0, GRAVITY, 0.0],
         Trajectory::Approach => [0.0; 3],
     };
+    cfg.motion.floor = world.trajectory.floor().map(|(y, _)| Floor::below(y, world.radius_m, ASSUMED_RESTITUTION));
     cfg
 }
 

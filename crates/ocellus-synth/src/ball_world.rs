@@ -205,6 +205,24 @@ pub(crate) fn circle_box(
     (lo(cx)..hi(cx, w), lo(cy)..hi(cy, h))
 }
 
+/// The floor of the thrown ball: its height (camera-frame y, down, metres) and restitution.
+const THROW_FLOOR: (f64, f64) = (0.55, 0.75);
+/// The floor of the bouncing ball.
+const BOUNCE_FLOOR: (f64, f64) = (0.45, 0.85);
+
+impl Trajectory {
+    /// The floor the ball bounces on: its height (camera-frame y, down, metres) and its
+    /// restitution (share of the normal speed a bounce keeps). `None` for the approach,
+    /// which flies without gravity.
+    pub fn floor(self) -> Option<(f64, f64)> {
+        match self {
+            Trajectory::Throw => Some(THROW_FLOOR),
+            Trajectory::Bounce => Some(BOUNCE_FLOOR),
+            Trajectory::Approach => None,
+        }
+    }
+}
+
 /// Physics substeps per frame.
 const SUBSTEPS: usize = 50;
 
@@ -262,8 +280,8 @@ impl BallWorld {
             Trajectory::Throw => ballistic(
                 [-0.7 + jitter(0.05), 0.3 + jitter(0.03), 2.4 + jitter(0.1)],
                 [0.9 + jitter(0.05), -3.4 + jitter(0.1), 0.25 + jitter(0.05)],
-                0.55,
-                0.75,
+                THROW_FLOOR.0,
+                THROW_FLOOR.1,
                 r,
                 dt,
                 n,
@@ -271,8 +289,8 @@ impl BallWorld {
             Trajectory::Bounce => ballistic(
                 [-0.3 + jitter(0.05), -0.5 + jitter(0.03), 1.8 + jitter(0.1)],
                 [0.35 + jitter(0.05), jitter(0.1), 0.3 + jitter(0.05)],
-                0.45,
-                0.85,
+                BOUNCE_FLOOR.0,
+                BOUNCE_FLOOR.1,
                 r,
                 dt,
                 n,

@@ -82,6 +82,10 @@ pub struct BallModel {
     /// Spread of a detection draw's velocity about the parent's predicted velocity, across
     /// and along the detection's line of sight, m/s (see `DetectorConfig`).
     pub detection_velocity_sigma_mps: [f64; 2],
+    /// A frame where no particle's circle has a colour score of at least this, in [-1, 1],
+    /// carries no evidence: the ball is hidden, and [`Self::weigh`] leaves the weights as
+    /// they are (`-1` weighs every frame).
+    pub evidence_score: f64,
 }
 
 impl BallModel {
@@ -149,7 +153,25 @@ impl BallModel {
         filter.propose(self, obs);
         let (w, h) = frame.size();
         obs.binned.update_region(frame, self.samples_region(filter.particles(), w, h));
-        Ok(filter.weigh_proposed(self, obs)?)
+        self.weigh(filter, obs)
+    }
+
+    /// The weight update of a step, after `filter.propose`: the colour likelihood of every
+    /// particle, unless no particle's circle scores [`Self::evidence_score`]. Then the ball
+    /// is taken to be hidden (a full occlusion) and the frame carries no evidence: the
+    /// particles keep their weights and coast on the motion model. Weighing such a frame
+    /// would hand the cloud to whichever wrong circles happen to score best, typically
+    /// tiny, far ones, and it would climb away from the ball while it is hidden.
+    pub fn weigh(&self, filter: &mut ParticleFilter<BallState>, obs: &BallFrame) -> Result<StepReport> {
+        let lambda = self.colour.lambda;
+        let least = lambda * self.evidence_score;
+        Ok(filter.weigh_proposed_with(|particles, out| {
+            particles.par_iter().zip(out.par_iter_mut()).for_each(|(p, l)| *l = self.log_likelihood(p, obs));
+            if out.iter().all(|&l| l < least) {
+                // Impossible states (behind the camera) stay impossible.
+                out.iter_mut().filter(|l| l.is_finite()).for_each(|l| *l = 0.0);
+            }
+        })?)
     }
 }
 
@@ -225,6 +247,7 @@ mod tests {
             colour: ColourModel::from_colour([240, 110, 30]),
             boost: 0.0,
             detection_velocity_sigma_mps: [3.0, 0.5],
+            evidence_score: -1.0,
         };
         let mut rng = SplitMix64::new(3);
         // A cloud about the ball, some of it reaching past the frame's edges.
@@ -247,5 +270,58 @@ mod tests {
             assert_eq!(a.to_bits(), b.to_bits(), "{s:?}");
         }
         assert_eq!(model.samples_region(&[], w, h), [0; 4]);
+    }
+
+    #[test]
+    fn a_frame_where_no_particle_sees_the_ball_carries_no_evidence() {
+        let photo = ocellus_io::read_image(ocellus_testdata::asset("chelsea.png")).unwrap().to_u8();
+        let (w, h) = photo.size();
+        let k = Intrinsics { fx: 500.0, fy: 500.0, cx: w as f64 / 2.0, cy: h as f64 / 2.0, skew: 0.0 };
+        let camera = PinholeCamera { k, r: Matrix3::identity(), t: Vector3::zeros() };
+        let ball = Vector3::new(0.0, 0.0, 1.5);
+        let c = project_ball(&camera, &Distortion::default(), &ball, 0.05).unwrap();
+        let with_ball = Plane::from_fn(w, h, |x, y| {
+            if (x as f64 - c.x).powi(2) + (y as f64 - c.y).powi(2) <= c.r * c.r {
+                [240, 110, 30]
+            } else {
+                photo.get(x, y)
+            }
+        });
+        let model = BallModel {
+            camera,
+            distortion: Distortion::default(),
+            radius_m: 0.05,
+            motion: MotionModel::at_fps(30.0),
+            colour: ColourModel::from_colour([240, 110, 30]),
+            boost: 0.0,
+            detection_velocity_sigma_mps: [3.0, 0.5],
+            evidence_score: 0.2,
+        };
+        let mut rng = SplitMix64::new(8);
+        let cloud: Vec<BallState> = (0..300)
+            .map(|_| BallState {
+                position: [0.02 * rng.normal(), 0.02 * rng.normal(), 1.5 + 0.1 * rng.normal()],
+                velocity: [0.0; 3],
+            })
+            .collect();
+        let cfg = ocellus_estimation::particle_filter::FilterConfig { resample_below: 0.0, ..Default::default() };
+        let weigh = |m: &BallModel, frame: &Plane<[u8; 3]>| {
+            let mut f = ParticleFilter::new(cfg, cloud.clone()).unwrap();
+            let obs = BallFrame { binned: BinnedFrame::new(frame), detections: Vec::new() };
+            f.propose(m, &obs);
+            let best =
+                f.particles().iter().map(|p| m.colour.score(&obs.binned, m.circle(p).unwrap())).fold(-1.0, f64::max);
+            (m.weigh(&mut f, &obs).unwrap().ess, best)
+        };
+        // The ball hidden (the photo alone): no circle scores 0.2, the weights stay equal.
+        let (ess, best) = weigh(&model, &photo);
+        assert!(best < 0.2, "{best}");
+        assert!((ess - 300.0).abs() < 1e-9, "{ess}");
+        // Weighed anyway, the cloud would follow the best wrong circles.
+        let always = BallModel { evidence_score: -1.0, ..model.clone() };
+        assert!(weigh(&always, &photo).0 < 250.0);
+        // The ball in view: the frame is weighed.
+        let (ess, best) = weigh(&model, &with_ball);
+        assert!(best > 0.5 && ess < 100.0, "best {best}, ess {ess}");
     }
 }

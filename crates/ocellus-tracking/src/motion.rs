@@ -36,6 +36,77 @@ pub struct MotionModel {
     pub jump_sigma_m: f64,
     /// Spread of a jump's velocity about the previous velocity, m/s.
     pub jump_sigma_mps: f64,
+    /// A floor the ball bounces on (`None`: no floor).
+    #[serde(default)]
+    pub floor: Option<Floor>,
+}
+
+/// A plane the ball's centre bounces off: a ball thrown or dropped onto the ground.
+///
+/// The centre may not pass `normal . p = offset_m` while moving along `normal`: when the
+/// noise-free flight of a step reaches the plane, the ball bounces at the instant of contact
+/// (found in closed form under the constant acceleration) and its velocity along `normal`
+/// turns and shrinks by `restitution`; the rest of the step flies on from there. For a floor
+/// at camera-frame height `y_floor` (y down) and a ball of radius `R`: `normal = [0, 1, 0]`,
+/// `offset_m = y_floor - R`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Floor {
+    /// Unit normal pointing into the floor, world axes.
+    pub normal: [f64; 3],
+    /// Where the centre touches: `normal . p = offset_m`, metres.
+    pub offset_m: f64,
+    /// Share of the normal speed kept by a bounce, in [0, 1].
+    pub restitution: f64,
+}
+
+impl Floor {
+    /// A horizontal floor for a camera frame with y down: the ball of `radius_m` touches it
+    /// when its centre's y is `y_floor_m - radius_m`.
+    pub fn below(y_floor_m: f64, radius_m: f64, restitution: f64) -> Self {
+        Self { normal: [0.0, 1.0, 0.0], offset_m: y_floor_m - radius_m, restitution }
+    }
+
+    /// Checks the parameters.
+    pub fn validate(&self) -> Result<()> {
+        let n = self.normal.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(n.is_finite() && (n - 1.0).abs() < 1e-6) {
+            return Err(TrackingError::Invalid(format!("floor normal {:?} is not a unit vector", self.normal)));
+        }
+        if !self.offset_m.is_finite() {
+            return Err(TrackingError::Invalid(format!("floor offset {} m is not finite", self.offset_m)));
+        }
+        if !(0.0..=1.0).contains(&self.restitution) {
+            return Err(TrackingError::Invalid(format!("restitution {} is outside [0, 1]", self.restitution)));
+        }
+        Ok(())
+    }
+
+    /// Time from the start of a step until the centre, at height `h` above the contact plane
+    /// (`h = offset - normal . p`, positive above) moving with normal speed `vn` under normal
+    /// acceleration `an`, touches it; `None` when not within `dt`.
+    fn contact_time(h: f64, vn: f64, an: f64, dt: f64) -> Option<f64> {
+        if h <= 0.0 {
+            // Already at or past the plane: it bounces now if it is still moving in.
+            return (vn > 0.0).then_some(0.0);
+        }
+        // h - vn t - an t^2 / 2 = 0, the first positive root.
+        let t = if an.abs() < 1e-12 {
+            (vn > 0.0).then(|| h / vn)?
+        } else {
+            let disc = vn * vn + 2.0 * an * h;
+            if disc < 0.0 {
+                return None;
+            }
+            // The root of the stable form: 2h / (vn + sqrt(disc)).
+            let d = vn + disc.sqrt();
+            if d <= 0.0 {
+                return None;
+            }
+            2.0 * h / d
+        };
+        (t <= dt).then_some(t)
+    }
 }
 
 impl MotionModel {
@@ -49,6 +120,7 @@ impl MotionModel {
             jump_prob: 0.02,
             jump_sigma_m: 1.0,
             jump_sigma_mps: 2.0,
+            floor: None,
         }
     }
 
@@ -72,16 +144,32 @@ impl MotionModel {
                 return bad(format!("{name} = {v} must be finite and positive"));
             }
         }
-        Ok(())
+        self.floor.as_ref().map_or(Ok(()), Floor::validate)
     }
 
-    /// The noise-free prediction of `prev` one step ahead.
+    /// The noise-free prediction of `prev` one step ahead, bouncing off the floor if any.
     pub fn predict(&self, prev: &BallState) -> BallState {
         let dt = self.dt_s;
         let mut s = *prev;
         for k in 0..3 {
             s.position[k] += prev.velocity[k] * dt + 0.5 * self.gravity[k] * dt * dt;
             s.velocity[k] += self.gravity[k] * dt;
+        }
+        let Some(f) = &self.floor else { return s };
+        let dot = |a: &[f64; 3]| f.normal[0] * a[0] + f.normal[1] * a[1] + f.normal[2] * a[2];
+        let (h, vn, an) = (f.offset_m - dot(&prev.position), dot(&prev.velocity), dot(&self.gravity));
+        let Some(tc) = Floor::contact_time(h, vn, an, dt) else { return s };
+        // Along the normal: fly to the contact, turn, fly the rest of the step. Across it the
+        // flight is unchanged. One bounce per step (a ball resting on the floor bounces with
+        // ever smaller speeds; the step's noise covers the rest).
+        let rest = dt - tc;
+        let v_out = -f.restitution * (vn + an * tc);
+        let h_end = -(v_out * rest + 0.5 * an * rest * rest);
+        let (pn, vn_end) = (f.offset_m - h_end.max(0.0), v_out + an * rest);
+        let (pn_free, vn_free) = (dot(&s.position), dot(&s.velocity));
+        for k in 0..3 {
+            s.position[k] += (pn - pn_free) * f.normal[k];
+            s.velocity[k] += (vn_end - vn_free) * f.normal[k];
         }
         s
     }
@@ -238,6 +326,62 @@ mod tests {
         assert!((jumpy.log_density(&prev, &p) - smooth.log_density(&prev, &p) - 0.98f64.ln()).abs() < 1e-6);
     }
 
+    /// The flight of `prev` over `dt` in `substeps` Euler-exact steps with the bounce
+    /// applied at each substep's end (the generator's way): the reference for `predict`.
+    fn fine_flight(prev: &BallState, g: f64, floor_c: f64, e: f64, dt: f64, substeps: usize) -> BallState {
+        let (mut p, mut v) = (prev.position, prev.velocity);
+        let h = dt / substeps as f64;
+        for _ in 0..substeps {
+            for k in 0..3 {
+                let a = if k == 1 { g } else { 0.0 };
+                p[k] += v[k] * h + 0.5 * a * h * h;
+                v[k] += a * h;
+            }
+            if p[1] > floor_c && v[1] > 0.0 {
+                p[1] = 2.0 * floor_c - p[1];
+                v[1] *= -e;
+            }
+        }
+        state(p, v)
+    }
+
+    #[test]
+    fn the_floor_bounces_the_prediction_at_the_instant_of_contact() {
+        let floor = Floor::below(0.5, 0.05, 0.8);
+        let m = MotionModel { gravity: [0.0, 9.81, 0.0], floor: Some(floor), ..MotionModel::at_fps(30.0) };
+        // Falling onto the floor within the step, early, late, and starting on it.
+        for (y, vy) in [(0.40, 3.0), (0.44, 0.5), (0.3, 4.0), (0.45, 2.0), (0.2, -1.0)] {
+            let prev = state([0.1, y, 2.0], [0.3, vy, -0.2]);
+            let got = m.predict(&prev);
+            let want = fine_flight(&prev, 9.81, 0.45, 0.8, m.dt_s, 200_000);
+            for k in 0..3 {
+                assert!((got.position[k] - want.position[k]).abs() < 1e-5, "y {y} vy {vy}: {got:?} vs {want:?}");
+                assert!((got.velocity[k] - want.velocity[k]).abs() < 1e-3, "y {y} vy {vy}: {got:?} vs {want:?}");
+            }
+            assert!(got.position[1] <= 0.45 + 1e-12);
+        }
+        // Far above the floor, or rising away from it: the free flight.
+        let free = MotionModel { floor: None, ..m };
+        for prev in [state([0.0, -0.5, 2.0], [0.0, 1.0, 0.0]), state([0.0, 0.44, 2.0], [0.0, -2.0, 0.0])] {
+            assert_eq!(m.predict(&prev), free.predict(&prev));
+        }
+        // A tilted floor bounces along its normal only: the speed along the plane is kept.
+        let n = [0.0, 0.6, 0.8];
+        let tilted = MotionModel {
+            gravity: [0.0; 3],
+            floor: Some(Floor { normal: n, offset_m: 1.0, restitution: 1.0 }),
+            ..MotionModel::at_fps(30.0)
+        };
+        let prev = state([0.0, 0.0, 1.2], [0.5, 3.0, 0.0]);
+        let s = tilted.predict(&prev);
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        assert!((dot(s.velocity, n) + dot(prev.velocity, n)).abs() < 1e-12, "{s:?}");
+        assert!((s.velocity[0] - 0.5).abs() < 1e-12);
+        let speed = |v: [f64; 3]| dot(v, v).sqrt();
+        assert!((speed(s.velocity) - speed(prev.velocity)).abs() < 1e-12);
+        assert!(dot(s.position, n) <= 1.0);
+    }
+
     #[test]
     fn bad_parameters_are_refused() {
         let ok = MotionModel::at_fps(60.0);
@@ -248,6 +392,9 @@ mod tests {
             MotionModel { gravity: [0.0, f64::INFINITY, 0.0], ..ok },
             MotionModel { jump_prob: 1.0, ..ok },
             MotionModel { jump_sigma_m: -1.0, ..ok },
+            MotionModel { floor: Some(Floor { normal: [0.0, 2.0, 0.0], offset_m: 0.5, restitution: 0.8 }), ..ok },
+            MotionModel { floor: Some(Floor { offset_m: f64::NAN, ..Floor::below(0.5, 0.05, 0.8) }), ..ok },
+            MotionModel { floor: Some(Floor::below(0.5, 0.05, 1.5)), ..ok },
         ] {
             assert!(m.validate().is_err(), "{m:?}");
         }

@@ -51,11 +51,18 @@ pub struct TrackerConfig {
     pub lambda: f64,
     /// The estimate is reported lost when the colour score of its circle is below this.
     pub lost_score: f64,
+    /// A frame where no particle's circle scores at least this carries no evidence (the
+    /// ball is hidden): the particles coast (see `BallModel::evidence_score`).
+    pub evidence_score: f64,
+    /// Share of the proposal drawn from the detections in a frame after a lost estimate,
+    /// in [0, 1] (at least `boost`; the plain filter, `boost = 0`, stays plain).
+    pub boost_when_lost: f64,
 }
 
 impl TrackerConfig {
     /// Defaults for frames at `fps`: 4000 particles, boost 0.2, resampling below ESS N/2,
-    /// lambda 20, lost below score 0.2.
+    /// lambda 20, lost below score 0.2, frames where no particle scores 0.2 carry no
+    /// evidence, the whole proposal from the detections after a loss.
     pub fn at_fps(fps: f64) -> Self {
         Self {
             particles: 4000,
@@ -65,6 +72,8 @@ impl TrackerConfig {
             detector: DetectorConfig::default(),
             lambda: crate::colour::DEFAULT_LAMBDA,
             lost_score: 0.2,
+            evidence_score: 0.2,
+            boost_when_lost: 1.0,
         }
     }
 
@@ -78,6 +87,12 @@ impl TrackerConfig {
         }
         if !(self.lost_score.is_finite() && (-1.0..=1.0).contains(&self.lost_score)) {
             return Err(TrackingError::Invalid(format!("lost_score {} is outside [-1, 1]", self.lost_score)));
+        }
+        if !(self.evidence_score.is_finite() && (-1.0..=1.0).contains(&self.evidence_score)) {
+            return Err(TrackingError::Invalid(format!("evidence_score {} is outside [-1, 1]", self.evidence_score)));
+        }
+        if !(0.0..=1.0).contains(&self.boost_when_lost) {
+            return Err(TrackingError::Invalid(format!("boost_when_lost {} is outside [0, 1]", self.boost_when_lost)));
         }
         if !(0.0..=1.0).contains(&self.filter.resample_below) {
             return Err(TrackingError::Invalid(format!(
@@ -118,6 +133,8 @@ pub struct BallTracker {
     filter: Option<ParticleFilter<BallState>>,
     obs: BallFrame,
     frame: usize,
+    /// Whether the last estimate was lost.
+    lost: bool,
 }
 
 impl BallTracker {
@@ -149,9 +166,10 @@ impl BallTracker {
                 cfg.detector.velocity_sigma_across_mps,
                 cfg.detector.velocity_sigma_along_mps,
             ],
+            evidence_score: cfg.evidence_score,
         };
         model.validate()?;
-        Ok(Self { cfg, model, filter: None, obs: BallFrame::default(), frame: 0 })
+        Ok(Self { cfg, model, filter: None, obs: BallFrame::default(), frame: 0, lost: true })
     }
 
     /// Moves the camera (a camera on a moving head: its pose for the next frame, world to
@@ -213,6 +231,7 @@ impl BallTracker {
             self.obs.binned.extend_region(frame, c.samples_rect(w, h));
         }
         let score = circle.map_or(-1.0, |c| self.model.colour.score(&self.obs.binned, c));
+        self.lost = score < self.cfg.lost_score;
         Ok(TrackEstimate {
             frame: k,
             position: Some(position),
@@ -220,7 +239,7 @@ impl BallTracker {
             circle,
             ess,
             score,
-            lost: score < self.cfg.lost_score,
+            lost: self.lost,
             detections: n_det,
         })
     }
@@ -234,7 +253,20 @@ impl BallTracker {
         self.obs.detections =
             detect_balls(&self.obs.binned, &m.colour, &m.camera, &m.distortion, m.radius_m, &self.cfg.detector);
         if let Some(f) = &mut self.filter {
-            return Ok(f.step(&self.model, &self.obs)?.ess);
+            // After a loss, the whole proposal comes from the detections (when there are
+            // any). Drawn from the old cloud, particles would compete with a found ball
+            // through their likelihood alone, while a detection far from where the cloud
+            // coasted pays the motion prior's small density in its importance weight: the
+            // cloud would stay with wrong circles. With every particle from the detections
+            // they compete on the likelihood and the prior alike.
+            let alpha = self.model.boost;
+            if self.lost && !self.obs.detections.is_empty() {
+                self.model.boost = self.cfg.boost_when_lost.max(alpha);
+            }
+            f.propose(&self.model, &self.obs);
+            let report = self.model.weigh(f, &self.obs);
+            self.model.boost = alpha;
+            return Ok(report?.ess);
         }
         // `detect_balls` orders the detections by colour score: start from the best.
         let Some(d) = self.obs.detections.first().copied() else {
@@ -261,5 +293,26 @@ impl BallTracker {
         let ess = f.ess();
         self.filter = Some(f);
         Ok(ess)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bad_settings_are_refused() {
+        let ok = TrackerConfig::at_fps(30.0);
+        assert!(ok.validate().is_ok());
+        for bad in [
+            TrackerConfig { particles: 0, ..ok },
+            TrackerConfig { lost_score: f64::NAN, ..ok },
+            TrackerConfig { evidence_score: 1.5, ..ok },
+            TrackerConfig { evidence_score: f64::INFINITY, ..ok },
+            TrackerConfig { boost_when_lost: -0.1, ..ok },
+            TrackerConfig { boost_when_lost: f64::NAN, ..ok },
+        ] {
+            assert!(bad.validate().is_err(), "{bad:?}");
+        }
     }
 }

@@ -43,8 +43,8 @@ fn a_thrown_ball_is_tracked_in_3d() {
     assert!(s.median_centre_error_px <= 2.0, "{s:?}");
     assert_eq!(s.lost_frames, 0, "{s:?}");
     // 3D: the depth comes from a radius of 10-12 px (1 px is about 9 % of the depth); issue
-    // 16 asks for 2 %, which this tracker does not reach yet (see the README's figures).
-    assert!(s.rmse_3d_percent_of_depth <= 15.0, "{s:?}");
+    // 16 asks for 2 %, which this tracker does not reach yet (3.5 % here; see the README).
+    assert!(s.rmse_3d_percent_of_depth <= 6.0, "{s:?}");
 }
 
 #[test]
@@ -56,5 +56,8 @@ fn the_boosted_filter_finds_the_ball_after_a_full_occlusion() {
     println!("boosted {boosted:?}\nplain {plain:?}");
     assert_eq!(boosted.reacquisition_delays.len(), 1);
     assert!(boosted.reacquisition_delays[0].is_some_and(|d| d <= 3), "{boosted:?}");
+    // Hidden, the cloud coasts on the motion model instead of following wrong circles
+    // (without that, 18 % of the depth on this run; 5.3 % with it).
+    assert!(boosted.rmse_3d_percent_of_depth <= 10.0, "{boosted:?}");
     assert!(boosted.lost_frames <= plain.lost_frames, "boosted {boosted:?}\nplain {plain:?}");
 }

@@ -16,6 +16,7 @@ use ocellus_image::Plane;
 use ocellus_tracking::ball::{project_ball, BallFrame, BallModel, BallState};
 use ocellus_tracking::colour::{BinnedFrame, Circle, ColourModel};
 use ocellus_tracking::motion::MotionModel;
+use ocellus_tracking::tracker::TrackerConfig;
 use serde_json::json;
 use std::time::Instant;
 
@@ -44,6 +45,7 @@ fn scene() -> Result<(Plane<[u8; 3]>, BallModel, Vector3<f64>)> {
         colour,
         boost: 0.0,
         detection_velocity_sigma_mps: [3.0, 0.5],
+        evidence_score: TrackerConfig::at_fps(30.0).evidence_score,
     };
     Ok((frame, model, ball))
 }
@@ -77,7 +79,8 @@ fn sir_step_ms(
             let s = Instant::now();
             if whole_frame {
                 obs.binned.update(frame);
-                pf.step(model, &obs)?;
+                pf.propose(model, &obs);
+                model.weigh(&mut pf, &obs)?;
             } else {
                 model.step_in_region(&mut pf, frame, &mut obs)?;
             }
