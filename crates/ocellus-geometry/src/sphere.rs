@@ -50,9 +50,10 @@ pub fn project_sphere(
     // conjugate half-diameters they span give the area, to first order in the lens's
     // curvature over the ellipse.
     let k = &camera.k;
+    // In normalized coordinates, as the lens model works (no round trip through pixels).
     let end = |a: f64, b: f64| {
-        let (u, v) = (rc * er[0] + a * er[0] + b * et[0], rc * er[1] + a * er[1] + b * et[1]);
-        distortion.distort_pixel(k, k.fx * u + k.skew * v + k.cx, k.fy * v + k.cy)
+        let (xd, yd) = distortion.distort(rc * er[0] + a * er[0] + b * et[0], rc * er[1] + a * er[1] + b * et[1]);
+        (k.fx * xd + k.skew * yd + k.cx, k.fy * yd + k.cy)
     };
     let (a0, a1) = (end(semi_radial, 0.0), end(-semi_radial, 0.0));
     let (b0, b1) = (end(0.0, semi_tangential), end(0.0, -semi_tangential));
