@@ -103,6 +103,12 @@ impl BallModel {
                 self.colour.lambda
             )));
         }
+        if !(self.colour.rim_weight.is_finite() && self.colour.rim_weight >= 0.0) {
+            return Err(TrackingError::Invalid(format!(
+                "rim weight {} must be finite and at least 0",
+                self.colour.rim_weight
+            )));
+        }
         self.motion.validate()
     }
 

@@ -7,6 +7,7 @@ use ocellus_eval::tracking::{score, EstimateFrame, TrackingScores, TruthFrame};
 use ocellus_image::Plane;
 use ocellus_synth::ball_world::{BallWorld, BallWorldConfig, Occlusion, Trajectory, GRAVITY};
 use ocellus_tracking::colour::{Circle, ColourModel};
+use ocellus_tracking::motion::Floor;
 use ocellus_tracking::tracker::{BallTracker, TrackerConfig};
 
 fn photo(name: &str) -> Plane<[f32; 3]> {
@@ -20,6 +21,8 @@ fn track(world: &BallWorld, boost: f64, seed: u64) -> TrackingScores {
     let colour = ColourModel::from_patch(&f0, Circle { x, y, r: 0.8 * r }).unwrap();
     let mut cfg = TrackerConfig::at_fps(world.config().fps);
     cfg.motion.gravity = [0.0, GRAVITY, 0.0];
+    // The robot knows its floor, not the ball's restitution.
+    cfg.motion.floor = world.config().trajectory.floor().map(|(y, _)| Floor::below(y, world.config().radius_m, 0.8));
     cfg.boost = boost;
     cfg.filter.seed = seed;
     let cam = *world.camera();
@@ -42,9 +45,10 @@ fn a_thrown_ball_is_tracked_in_3d() {
     println!("{s:?}");
     assert!(s.median_centre_error_px <= 2.0, "{s:?}");
     assert_eq!(s.lost_frames, 0, "{s:?}");
-    // 3D: the depth comes from a radius of 10-12 px (1 px is about 9 % of the depth); issue
-    // 16 asks for 2 %, which this tracker does not reach yet (3.5 % here; see the README).
-    assert!(s.rmse_3d_percent_of_depth <= 6.0, "{s:?}");
+    // 3D: the depth comes from a radius of 10-12 px (1 px is about 9 % of the depth): 1.7 %
+    // here (issue 16 asks for 2 %; 3.5 % before the guard band and the rim term of
+    // `ocellus_tracking::colour`, 9.7 % before the silhouette circle and the floor).
+    assert!(s.rmse_3d_percent_of_depth <= 3.0, "{s:?}");
 }
 
 #[test]
@@ -57,7 +61,7 @@ fn the_boosted_filter_finds_the_ball_after_a_full_occlusion() {
     assert_eq!(boosted.reacquisition_delays.len(), 1);
     assert!(boosted.reacquisition_delays[0].is_some_and(|d| d <= 3), "{boosted:?}");
     // Hidden, the cloud coasts on the motion model instead of following wrong circles
-    // (without that, 18 % of the depth on this run; 5.3 % with it).
+    // (without that, 18 % of the depth on this run; 6.7 % with it).
     assert!(boosted.rmse_3d_percent_of_depth <= 10.0, "{boosted:?}");
     assert!(boosted.lost_frames <= plain.lost_frames, "boosted {boosted:?}\nplain {plain:?}");
 }
