@@ -526,18 +526,28 @@ impl ColourModel {
             return -1.0;
         }
         let (ri, ro) = (circle.inner_scale(), r + EDGE_GUARD_PX);
+        let vote = |inside: bool, outside: bool| match (inside, outside) {
+            (_, true) => -1,
+            (true, false) => 1,
+            (false, false) => 0,
+        };
+        let [x0, y0, x1, y1] = frame.region.map(|v| v as f64);
+        if x - ro - 1.0 >= x0 && y - ro - 1.0 >= y0 && x + ro + 1.0 < x1 && y + ro + 1.0 < y1 {
+            // Every ray on the frame: no per-sample bounds test (as in `score`).
+            let (data, stride) = (frame.bins.as_slice(), frame.bins.stride() as i64);
+            let at = |rad: f64, p: &[f64; 2]| {
+                self.member[data[(nearest(y + rad * p[1]) * stride + nearest(x + rad * p[0])) as usize] as usize]
+            };
+            let votes: i32 = self.rays.iter().map(|p| vote(at(ri, p), at(ro, p))).sum();
+            return f64::from(votes) / RIM_SAMPLES as f64;
+        }
         let member = |b: Option<u8>| b.is_some_and(|b| self.member[b as usize]);
         let votes: i32 = self
             .rays
             .iter()
             .map(|p| {
                 let outside = member(frame.at(x + ro * p[0], y + ro * p[1]));
-                let inside = member(frame.at(x + ri * p[0], y + ri * p[1]));
-                match (inside, outside) {
-                    (_, true) => -1,
-                    (true, false) => 1,
-                    (false, false) => 0,
-                }
+                vote(member(frame.at(x + ri * p[0], y + ri * p[1])), outside)
             })
             .sum();
         f64::from(votes) / RIM_SAMPLES as f64
@@ -724,6 +734,34 @@ mod tests {
             let (fast, slow) = (model.score(&binned, c), slow_score(&model, &binned, c));
             assert!((fast - slow).abs() < 1e-12, "{c:?}: {fast} vs {slow}");
         }
+    }
+
+    #[test]
+    fn the_fast_rim_is_the_bounds_checked_one() {
+        let (frame, truth) = scene(false);
+        let model = ColourModel::from_patch(&frame, Circle { r: 12.0, ..truth }).unwrap();
+        let binned = BinnedFrame::new(&frame);
+        let mut rng = ocellus_image::rng::SplitMix64::new(5);
+        for _ in 0..2000 {
+            let c = Circle { x: 220.0 * rng.unit() - 10.0, y: 170.0 * rng.unit() - 10.0, r: 0.5 + 40.0 * rng.unit() };
+            let slow: i32 = model
+                .rays
+                .iter()
+                .map(|p| {
+                    let m = |rad: f64| frame_member(&model, &binned, c.x + rad * p[0], c.y + rad * p[1]);
+                    match (m(c.inner_scale()), m(c.r + EDGE_GUARD_PX)) {
+                        (_, true) => -1,
+                        (true, false) => 1,
+                        (false, false) => 0,
+                    }
+                })
+                .sum();
+            assert_eq!(model.rim(&binned, c), f64::from(slow) / RIM_SAMPLES as f64, "{c:?}");
+        }
+    }
+
+    fn frame_member(m: &ColourModel, frame: &BinnedFrame, x: f64, y: f64) -> bool {
+        frame.at(x, y).is_some_and(|b| m.member[b as usize])
     }
 
     #[test]
