@@ -229,15 +229,18 @@ mod tests {
     use nalgebra::Matrix3;
     use ocellus_geometry::camera::Intrinsics;
 
-    #[test]
-    fn binning_only_the_particles_region_gives_the_scores_of_the_whole_frame() {
+    /// The cat photo, the same with an orange ball of 5 cm at `ball` seen through a camera of
+    /// focal 500 px with `distortion`, and the plain filter's model of it.
+    fn ball_on_photo(
+        distortion: Distortion,
+        ball: &Vector3<f64>,
+        evidence_score: f64,
+    ) -> (Plane<[u8; 3]>, Plane<[u8; 3]>, BallModel) {
         let photo = ocellus_io::read_image(ocellus_testdata::asset("chelsea.png")).unwrap().to_u8();
         let (w, h) = photo.size();
         let k = Intrinsics { fx: 500.0, fy: 500.0, cx: w as f64 / 2.0, cy: h as f64 / 2.0, skew: 0.0 };
         let camera = PinholeCamera { k, r: Matrix3::identity(), t: Vector3::zeros() };
-        let distortion = Distortion { k1: -0.1, k2: 0.01, k3: 0.0, p1: 0.0, p2: 0.0 };
-        let ball = Vector3::new(0.1, 0.05, 1.5);
-        let c = project_ball(&camera, &distortion, &ball, 0.05).unwrap();
+        let c = project_ball(&camera, &distortion, ball, 0.05).unwrap();
         let frame = Plane::from_fn(w, h, |x, y| {
             if (x as f64 - c.x).powi(2) + (y as f64 - c.y).powi(2) <= c.r * c.r {
                 [240, 110, 30]
@@ -253,8 +256,17 @@ mod tests {
             colour: ColourModel::from_colour([240, 110, 30]),
             boost: 0.0,
             detection_velocity_sigma_mps: [3.0, 0.5],
-            evidence_score: -1.0,
+            evidence_score,
         };
+        (photo, frame, model)
+    }
+
+    #[test]
+    fn binning_only_the_particles_region_gives_the_scores_of_the_whole_frame() {
+        let distortion = Distortion { k1: -0.1, k2: 0.01, k3: 0.0, p1: 0.0, p2: 0.0 };
+        let ball = Vector3::new(0.1, 0.05, 1.5);
+        let (_, frame, model) = ball_on_photo(distortion, &ball, -1.0);
+        let (w, h) = frame.size();
         let mut rng = SplitMix64::new(3);
         // A cloud about the ball, some of it reaching past the frame's edges.
         let states: Vec<BallState> = (0..500)
@@ -280,29 +292,7 @@ mod tests {
 
     #[test]
     fn a_frame_where_no_particle_sees_the_ball_carries_no_evidence() {
-        let photo = ocellus_io::read_image(ocellus_testdata::asset("chelsea.png")).unwrap().to_u8();
-        let (w, h) = photo.size();
-        let k = Intrinsics { fx: 500.0, fy: 500.0, cx: w as f64 / 2.0, cy: h as f64 / 2.0, skew: 0.0 };
-        let camera = PinholeCamera { k, r: Matrix3::identity(), t: Vector3::zeros() };
-        let ball = Vector3::new(0.0, 0.0, 1.5);
-        let c = project_ball(&camera, &Distortion::default(), &ball, 0.05).unwrap();
-        let with_ball = Plane::from_fn(w, h, |x, y| {
-            if (x as f64 - c.x).powi(2) + (y as f64 - c.y).powi(2) <= c.r * c.r {
-                [240, 110, 30]
-            } else {
-                photo.get(x, y)
-            }
-        });
-        let model = BallModel {
-            camera,
-            distortion: Distortion::default(),
-            radius_m: 0.05,
-            motion: MotionModel::at_fps(30.0),
-            colour: ColourModel::from_colour([240, 110, 30]),
-            boost: 0.0,
-            detection_velocity_sigma_mps: [3.0, 0.5],
-            evidence_score: 0.2,
-        };
+        let (photo, with_ball, model) = ball_on_photo(Distortion::default(), &Vector3::new(0.0, 0.0, 1.5), 0.2);
         let mut rng = SplitMix64::new(8);
         let cloud: Vec<BallState> = (0..300)
             .map(|_| BallState {
