@@ -4,9 +4,10 @@
 //!
 //! - [`colour`]: HSV colour histograms (Pérez et al. 2002), a frame binned once, and the
 //!   seed's likelihood `BC(inner, model) - BC(inner, outer)` of an image circle from sample
-//!   points on the disc and on a ring just outside it (SPEC 7.2);
+//!   points on the disc and on a ring just outside it, skipping a guard band about the edge,
+//!   plus a rim term that votes on the edge itself (SPEC 7.2);
 //! - [`motion`]: constant velocity with gravity and white acceleration noise, plus rare jumps
-//!   (SPEC 7.3);
+//!   and an optional floor the ball bounces on (SPEC 7.3);
 //! - [`detection`]: colour-segmentation blobs as 3D ball hypotheses, depth from the blob size
 //!   and the known radius (SPEC 7.4);
 //! - [`ball`]: the 3D ball projected through a calibrated camera with distortion, as a
