@@ -6,7 +6,8 @@
 //! particle moves by [`MotionModel`] or, boosted, is drawn from a bottom-up detection
 //! (SPEC 7.4), and is weighed by the colour likelihood of the ball's image circle.
 
-use crate::colour::{union_rect, BinnedFrame, Circle, ColourModel};
+use crate::binning::{union_rect, BinnedFrame};
+use crate::colour::{Circle, ColourModel};
 use crate::detection::BallDetection;
 use crate::motion::{log_add, MotionModel};
 use crate::{Result, TrackingError};

@@ -13,7 +13,8 @@
 //! sphere of radius R at distance d seen with focal f: `r = f R / sqrt(d^2 - R^2)`, so
 //! `d = R sqrt(1 + f^2 / r^2)`.
 
-use crate::colour::{BinnedFrame, Circle, ColourModel, Histogram, BINS};
+use crate::binning::{BinnedFrame, Histogram, BINS};
+use crate::colour::{Circle, ColourModel};
 use crate::{Result, TrackingError};
 use nalgebra::{Vector2, Vector3};
 use ocellus_geometry::camera::PinholeCamera;

@@ -2,8 +2,8 @@
 //! filters and resamplers are in `ocellus-estimation`; this crate says how well a hypothesis
 //! explains a frame.
 //!
-//! - [`colour`]: HSV colour histograms (Pérez et al. 2002), a frame binned once, and the
-//!   seed's likelihood `BC(inner, model) - BC(inner, outer)` of an image circle from sample
+//! - [`binning`]: HSV colour histograms (Pérez et al. 2002) and a frame binned once;
+//! - [`colour`]: the seed's likelihood `BC(inner, model) - BC(inner, outer)` of an image circle from sample
 //!   points on the disc and on a ring just outside it, skipping a guard band about the edge,
 //!   plus a rim term that votes on the edge itself (SPEC 7.2);
 //! - [`motion`]: constant velocity with gravity and white acceleration noise, plus rare jumps
@@ -19,7 +19,8 @@
 //!
 //! ```
 //! use ocellus_image::Plane;
-//! use ocellus_tracking::colour::{BinnedFrame, Circle, ColourModel};
+//! use ocellus_tracking::binning::BinnedFrame;
+//! use ocellus_tracking::colour::{Circle, ColourModel};
 //! // A red disc of radius 12 at (40, 30) on a grey frame.
 //! let frame = Plane::from_fn(80, 60, |x, y| {
 //!     let d2 = (x as f64 - 40.0).powi(2) + (y as f64 - 30.0).powi(2);
@@ -34,6 +35,7 @@
 //! ```
 
 pub mod ball;
+pub mod binning;
 pub mod colour;
 pub mod detection;
 pub mod motion;

@@ -147,7 +147,7 @@ impl BallTracker {
         mut colour: ColourModel,
     ) -> Result<Self> {
         cfg.validate()?;
-        let grey: f64 = colour.histogram().0[crate::colour::HUE_BINS * crate::colour::SATURATION_BINS..].iter().sum();
+        let grey: f64 = colour.histogram().0[crate::binning::HUE_BINS * crate::binning::SATURATION_BINS..].iter().sum();
         if grey > 0.5 {
             return Err(TrackingError::Invalid(format!(
                 "{:.0} % of the colour model is grey, black or white (no reliable hue): pick a patch on the coloured ball",
