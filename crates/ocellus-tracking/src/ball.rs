@@ -83,9 +83,10 @@ pub struct BallModel {
     /// Spread of a detection draw's velocity about the parent's predicted velocity, across
     /// and along the detection's line of sight, m/s (see `DetectorConfig`).
     pub detection_velocity_sigma_mps: [f64; 2],
-    /// A frame where no particle's circle has a colour score of at least this, in [-1, 1],
-    /// carries no evidence: the ball is hidden, and [`Self::weigh`] leaves the weights as
-    /// they are (`-1` weighs every frame).
+    /// A frame where no particle's circle reaches this, in [-1, 1], carries no evidence: the
+    /// ball is hidden, and [`Self::weigh`] leaves the weights as they are (`-1` weighs every
+    /// frame). Compared with the likelihood's exponent over lambda: the colour score plus
+    /// the weighted rim term (`ColourModel::log_likelihood`).
     pub evidence_score: f64,
 }
 
@@ -164,7 +165,7 @@ impl BallModel {
     }
 
     /// The weight update of a step, after `filter.propose`: the colour likelihood of every
-    /// particle, unless no particle's circle scores [`Self::evidence_score`]. Then the ball
+    /// particle, unless no particle's circle reaches [`Self::evidence_score`]. Then the ball
     /// is taken to be hidden (a full occlusion) and the frame carries no evidence: the
     /// particles keep their weights and coast on the motion model. Weighing such a frame
     /// would hand the cloud to whichever wrong circles happen to score best, typically

@@ -387,9 +387,7 @@ mod tests {
         let (frame, truth) = scene(false);
         let model = ColourModel::from_patch(&frame, Circle { r: 12.0, ..truth }).unwrap();
         let binned = BinnedFrame::new(&frame);
-        let mut rng = ocellus_image::rng::SplitMix64::new(4);
-        for _ in 0..2000 {
-            let c = Circle { x: 220.0 * rng.unit() - 10.0, y: 170.0 * rng.unit() - 10.0, r: 0.5 + 40.0 * rng.unit() };
+        for c in random_circles(4) {
             let (fast, slow) = (model.score(&binned, c), slow_score(&model, &binned, c));
             assert!((fast - slow).abs() < 1e-12, "{c:?}: {fast} vs {slow}");
         }
@@ -400,9 +398,7 @@ mod tests {
         let (frame, truth) = scene(false);
         let model = ColourModel::from_patch(&frame, Circle { r: 12.0, ..truth }).unwrap();
         let binned = BinnedFrame::new(&frame);
-        let mut rng = ocellus_image::rng::SplitMix64::new(5);
-        for _ in 0..2000 {
-            let c = Circle { x: 220.0 * rng.unit() - 10.0, y: 170.0 * rng.unit() - 10.0, r: 0.5 + 40.0 * rng.unit() };
+        for c in random_circles(5) {
             let slow: i32 = model
                 .rays
                 .iter()
@@ -417,6 +413,14 @@ mod tests {
                 .sum();
             assert_eq!(model.rim(&binned, c), f64::from(slow) / RIM_SAMPLES as f64, "{c:?}");
         }
+    }
+
+    /// 2000 circles over and around the 200 x 150 scene, radii 0.5-40.5 px.
+    fn random_circles(seed: u64) -> Vec<Circle> {
+        let mut rng = ocellus_image::rng::SplitMix64::new(seed);
+        (0..2000)
+            .map(|_| Circle { x: 220.0 * rng.unit() - 10.0, y: 170.0 * rng.unit() - 10.0, r: 0.5 + 40.0 * rng.unit() })
+            .collect()
     }
 
     fn frame_member(m: &ColourModel, frame: &BinnedFrame, x: f64, y: f64) -> bool {
