@@ -83,8 +83,8 @@ pub struct ParticleFilter<S> {
     particles: Vec<S>,
     log_w: Vec<f64>,
     steps: u64,
-    // Reused per step: incremental log weights, log likelihoods, normalized weights, parents, and the next
-    // generation while resampling.
+    // Reused per step: incremental log weights, log likelihoods, normalized weights,
+    // parents, and the next generation while resampling.
     increments: Vec<f64>,
     likelihoods: Vec<f64>,
     weights: Vec<f64>,
