@@ -160,8 +160,12 @@ impl BallModel {
         obs.detections.clear();
         filter.propose(self, obs);
         let (w, h) = frame.size();
-        obs.binned.update_region(frame, self.samples_region(filter.particles(), w, h));
-        self.weigh(filter, obs)
+        // Each circle is projected once, for the region and for the likelihood.
+        let circles: Vec<Option<Circle>> = filter.particles().par_iter().map(|s| self.circle(s)).collect();
+        let region =
+            circles.par_iter().map(|c| c.map_or([0; 4], |c| c.samples_rect(w, h))).reduce(|| [0; 4], union_rect);
+        obs.binned.update_region(frame, region);
+        self.weigh_circles(filter, obs, &circles)
     }
 
     /// The weight update of a step, after `filter.propose`: the colour likelihood of every
@@ -171,10 +175,25 @@ impl BallModel {
     /// would hand the cloud to whichever wrong circles happen to score best, typically
     /// tiny, far ones, and it would climb away from the ball while it is hidden.
     pub fn weigh(&self, filter: &mut ParticleFilter<BallState>, obs: &BallFrame) -> Result<StepReport> {
+        let circles: Vec<Option<Circle>> = filter.particles().par_iter().map(|s| self.circle(s)).collect();
+        self.weigh_circles(filter, obs, &circles)
+    }
+
+    /// [`Self::weigh`] with the particles' image circles already projected (`circles[i]` of
+    /// particle `i`; `None` out of view).
+    fn weigh_circles(
+        &self,
+        filter: &mut ParticleFilter<BallState>,
+        obs: &BallFrame,
+        circles: &[Option<Circle>],
+    ) -> Result<StepReport> {
         let lambda = self.colour.lambda;
         let least = lambda * self.evidence_score;
-        Ok(filter.weigh_proposed_with(|particles, out| {
-            particles.par_iter().zip(out.par_iter_mut()).for_each(|(p, l)| *l = self.log_likelihood(p, obs));
+        let binned = &obs.binned;
+        Ok(filter.weigh_proposed_with(|_, out| {
+            out.par_iter_mut().zip(circles.par_iter()).for_each(|(l, c)| {
+                *l = c.map_or(f64::NEG_INFINITY, |c| self.colour.log_likelihood(binned, c));
+            });
             if out.iter().all(|&l| l < least) {
                 // Impossible states (behind the camera) stay impossible.
                 out.iter_mut().filter(|l| l.is_finite()).for_each(|l| *l = 0.0);

@@ -86,6 +86,81 @@ fn bin_block(src: &[[u8; 3]], dst: &mut [u8]) {
     dst.copy_from_slice(&out);
 }
 
+/// Bins a row 8 pixels at a time with explicit AVX2 intrinsics; returns how many pixels it
+/// binned (the rest, at most 16, is left to the caller). Written by hand because the compiler
+/// vectorizes [`bin_block`] only in part: it de-interleaves the RGB triplets and packs the
+/// bins back lane by lane, in scalar code, and binning the frame took 0.8 ms of a 1.9 ms
+/// tracker step on an AMD EPYC (Zen 3) core. The arithmetic is [`bin_block`]'s, in the same
+/// order, except the value bin `floor(10 M / 255)`, taken as `floor(M * (10 / 255) + 1e-4)`:
+/// `10 M / 255` is an integer or at least 1/51 below the next one, and the product is within
+/// 1e-6 of it, so the floor is exact without a division.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn bin_row_avx2(src: &[[u8; 3]], dst: &mut [u8]) -> usize {
+    use std::arch::x86_64::*;
+    let n = src.len().min(dst.len());
+    let bytes = src.as_ptr() as *const u8;
+    let mut i = 0;
+    // SAFETY (whole body): AVX2 is there (the caller's promise); the two 16-byte loads of a
+    // block read bytes 3i..3i + 28, inside the row while 3i + 28 <= 3n; the 8-byte store
+    // writes dst[i..i + 8] with i + 8 <= n.
+    unsafe {
+        // Each 128-bit half holds 4 pixels (12 bytes); pick one channel's byte into the low
+        // byte of each 32-bit lane.
+        let pick = |c: i8| {
+            let z = -1i8;
+            _mm256_broadcastsi128_si256(_mm_setr_epi8(c, z, z, z, c + 3, z, z, z, c + 6, z, z, z, c + 9, z, z, z))
+        };
+        let (pr, pg, pb) = (pick(0), pick(1), pick(2));
+        let f = _mm256_set1_ps;
+        let (zero, one, two, four, six, nine, ten) = (f(0.0), f(1.0), f(2.0), f(4.0), f(6.0), f(9.0), f(10.0));
+        let (dark, value_scale, nudge, grey_base) = (f(51.0), f(10.0 / 255.0), f(1e-4), f(100.0));
+        while i + 8 <= n && 3 * i + 28 <= 3 * n {
+            let lo = _mm_loadu_si128(bytes.add(3 * i) as *const __m128i);
+            let hi = _mm_loadu_si128(bytes.add(3 * i + 12) as *const __m128i);
+            let v = _mm256_inserti128_si256::<1>(_mm256_castsi128_si256(lo), hi);
+            let r = _mm256_cvtepi32_ps(_mm256_shuffle_epi8(v, pr));
+            let g = _mm256_cvtepi32_ps(_mm256_shuffle_epi8(v, pg));
+            let b = _mm256_cvtepi32_ps(_mm256_shuffle_epi8(v, pb));
+            let mx = _mm256_max_ps(_mm256_max_ps(r, g), b);
+            let mn = _mm256_min_ps(_mm256_min_ps(r, g), b);
+            let d = _mm256_sub_ps(mx, mn);
+            let grey = _mm256_or_ps(
+                _mm256_cmp_ps::<_CMP_LE_OQ>(_mm256_mul_ps(ten, d), mx),
+                _mm256_cmp_ps::<_CMP_LE_OQ>(mx, dark),
+            );
+            let vb = _mm256_min_ps(_mm256_floor_ps(_mm256_add_ps(_mm256_mul_ps(mx, value_scale), nudge)), nine);
+            // Hue numerators: red maximum (wrapped by 6 d when g < b), green, blue.
+            let g_b = _mm256_sub_ps(g, b);
+            let wrap = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(g, b), _mm256_mul_ps(six, d));
+            let num_r = _mm256_add_ps(g_b, wrap);
+            let num_g = _mm256_add_ps(_mm256_mul_ps(two, d), _mm256_sub_ps(b, r));
+            let num_b = _mm256_add_ps(_mm256_mul_ps(four, d), _mm256_sub_ps(r, g));
+            let num = _mm256_blendv_ps(num_b, num_g, _mm256_cmp_ps::<_CMP_EQ_OQ>(mx, g));
+            let num = _mm256_blendv_ps(num, num_r, _mm256_cmp_ps::<_CMP_EQ_OQ>(mx, r));
+            let dd = _mm256_max_ps(d, one);
+            let hb = _mm256_div_ps(_mm256_mul_ps(ten, num), _mm256_mul_ps(six, dd));
+            let hb = _mm256_min_ps(_mm256_floor_ps(hb), nine);
+            let sb = _mm256_div_ps(_mm256_mul_ps(ten, d), _mm256_max_ps(mx, one));
+            let sb = _mm256_min_ps(_mm256_floor_ps(sb), nine);
+            let colour = _mm256_add_ps(_mm256_mul_ps(hb, ten), sb);
+            let bin = _mm256_blendv_ps(colour, _mm256_add_ps(grey_base, vb), grey);
+            let bin = _mm256_max_ps(bin, zero);
+            // 8 x i32 -> 8 bytes: each 128-bit half packs its 4 lanes into its low 4 bytes.
+            let w = _mm256_cvttps_epi32(bin);
+            let p = _mm256_packus_epi16(_mm256_packs_epi32(w, w), _mm256_packs_epi32(w, w));
+            let lo4 = _mm256_cvtsi256_si32(p) as u32 as u64;
+            let hi4 = _mm256_extract_epi32::<4>(p) as u32 as u64;
+            (dst.as_mut_ptr().add(i) as *mut u64).write_unaligned(lo4 | hi4 << 32);
+            i += 8;
+        }
+    }
+    i
+}
+
 /// Bins the pixels of `frame` in columns `x0..x1` of rows `y0..y1` into `out` (same size as
 /// the frame; the caller clamps the rectangle to it). `M` only selects the build (the kernel
 /// has no multiply-add); [`ocellus_image::dispatch_kernel!`] compiles it with AVX2.
@@ -98,6 +173,14 @@ fn bin_rect_generic<M: ocellus_image::simd::Madd>(
 ) {
     for y in y0..y1 {
         let (src, dst) = (&frame.row(y)[x0..x1], &mut out.row_mut(y)[x0..x1]);
+        #[cfg(target_arch = "x86_64")]
+        let (src, dst) = if M::AVX2 {
+            // SAFETY: M::AVX2 is only instantiated inside functions compiled with AVX2.
+            let done = unsafe { bin_row_avx2(src, dst) };
+            (&src[done..], &mut dst[done..])
+        } else {
+            (src, dst)
+        };
         let n = src.len() / BIN_BLOCK * BIN_BLOCK;
         for (s, d) in src[..n].chunks_exact(BIN_BLOCK).zip(dst[..n].chunks_exact_mut(BIN_BLOCK)) {
             bin_block(s, d);
@@ -285,7 +368,11 @@ mod tests {
         // All 2^24 colours would take long in a debug build; a 2^18 lattice that includes
         // the extremes and every value of one channel at a time.
         let steps: Vec<u8> = (0..=255u8).step_by(4).chain([1, 2, 3, 254, 255, 51, 52, 25, 26]).collect();
-        let mut colours = Vec::new();
+        // Every maximum, as a grey and as a pure and a half-saturated red, green and blue (the
+        // value bins' boundaries sit at maxima 51, 102, 153, 204 and 255).
+        let mut colours: Vec<[u8; 3]> = (0..=255u8)
+            .flat_map(|v| [[v, v, v], [v, 0, 0], [0, v, 0], [0, 0, v], [v, v / 2, v / 2], [v / 2, v, 0], [0, v / 3, v]])
+            .collect();
         for &r in &steps {
             for &g in &steps {
                 for &b in &steps {
@@ -310,6 +397,24 @@ mod tests {
         assert!(bin_of([250, 224, 224]) < 100);
         assert_eq!(bin_of([51, 0, 0]), 102, "V = 0.2 exactly is a value bin");
         assert_eq!(bin_of([52, 0, 0]), 9);
+    }
+
+    #[test]
+    fn every_backend_bins_all_2_pow_24_colours_as_the_integer_definition() {
+        // One 256 x 256 frame per red level, green along x and blue along y.
+        let mut bf = BinnedFrame::default();
+        for r in 0..=255u8 {
+            let frame = Plane::from_fn(256, 256, |g, b| [r, g as u8, b as u8]);
+            for backend in Backend::available() {
+                bf.update_with(backend, &frame);
+                for b in 0..256 {
+                    for g in 0..256 {
+                        let want = bin_of([r, g as u8, b as u8]);
+                        assert_eq!(bf.bins().get(g, b), want, "{backend:?} ({r}, {g}, {b})");
+                    }
+                }
+            }
+        }
     }
 
     #[test]
