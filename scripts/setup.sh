@@ -1,13 +1,18 @@
 #!/usr/bin/env bash
 # Installs the system packages ocellus needs on a fresh Debian machine.
 # The build needs a Rust toolchain and a C compiler; video input (ocellus attend/surprise and
-# their tests) runs the ffmpeg program as a subprocess.
+# their tests) runs the ffmpeg program as a subprocess; the GPU backend needs a Vulkan loader
+# and, without a GPU, a software Vulkan driver.
 set -euo pipefail
 
 need=()
 command -v cc >/dev/null 2>&1 || need+=(gcc)
 command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
 command -v ffmpeg >/dev/null 2>&1 || need+=(ffmpeg)
+# The GPU backend's tests (crates/ocellus-gpu) run on Mesa's software Vulkan driver
+# (lavapipe) where there is no GPU.
+ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1 || need+=(mesa-vulkan-drivers)
+ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1' || need+=(libvulkan1)
 
 if [ ${#need[@]} -gt 0 ]; then
   if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi

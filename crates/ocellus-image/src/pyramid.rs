@@ -86,8 +86,10 @@ impl PyramidKernel {
         Ok(())
     }
 
-    /// Taps (input index, weight) for output `j` of a dimension of length `n`, renormalized.
-    fn taps_for(&self, j: usize, n: usize, out: &mut Vec<(usize, f32)>) {
+    /// Taps (input index, weight) for output `j` of a dimension of length `n`, renormalized
+    /// to sum 1 where the kernel is truncated at a border (SPEC 1.2); written into `out`.
+    /// Other backends (the GPU's) build their tap tables from this one rule.
+    pub fn taps_for(&self, j: usize, n: usize, out: &mut Vec<(usize, f32)>) {
         out.clear();
         if self.stb_size3_rule && n == 3 {
             out.extend_from_slice(&[(0, 0.25), (1, 0.5), (2, 0.25)]);

@@ -44,6 +44,17 @@ pub enum Source {
     External(usize),
 }
 
+/// Pyramid levels computed outside a [`SaliencyEngine`] (see
+/// [`SaliencyEngine::process_front_end`]).
+#[derive(Clone, Debug, Default)]
+pub struct FrontEnd {
+    /// Intensity, red-green and blue-yellow, indexed `[channel][level]`; levels outside
+    /// [`SaliencyEngine::used_levels`] may be empty.
+    pub opponency: [Vec<Plane<f32>>; 3],
+    /// Gabor energy `M_theta`, indexed `[level][angle]` (angles in the configuration's order).
+    pub orientation: Vec<Vec<Plane<f32>>>,
+}
+
 /// The Gaussian pyramids of one frame, levels 0..=max_level; levels a source does not need
 /// stay empty.
 #[derive(Debug)]
@@ -463,6 +474,80 @@ impl SaliencyEngine {
             g.filter(self.backend, &self.pyr.opp[0][l], &mut self.pyr.ori[l])?;
         }
         Ok(())
+    }
+
+    /// Runs the rest of the pipeline (rescale, center-surround, N(.), combination) on
+    /// pyramid levels computed elsewhere, e.g. by the GPU backend (`ocellus-gpu`): the
+    /// intensity, red-green and blue-yellow levels and the Gabor energies of every level in
+    /// [`Self::used_levels`], each of that level's size. Only for configurations whose
+    /// channels are intensity, colour and orientation. The stage timings of the front end
+    /// (pyramid, orientation) read zero.
+    pub fn process_front_end(&mut self, front: &FrontEnd) -> Result<&Plane<f32>> {
+        if let Some(c) = self
+            .cfg
+            .channels
+            .iter()
+            .find(|c| !matches!(c.kind, ChannelKind::Intensity | ChannelKind::Color | ChannelKind::Orientation))
+        {
+            return Err(AttentionError::InvalidInput(format!(
+                "a precomputed front end carries intensity, colour and orientation only; the configuration has {:?}",
+                c.kind
+            )));
+        }
+        let n_angles = self.cfg.gabor.angles_deg.len();
+        let need_ori = self.gabor.is_some();
+        for &l in &self.used_levels {
+            let want = self.sizes[l];
+            let planes = front.opponency.iter().map(|p| p.get(l));
+            let ori = front.orientation.get(l).map(|v| v.iter().map(Some).collect::<Vec<_>>());
+            let ori = if need_ori { ori.unwrap_or_else(|| vec![None; n_angles]) } else { Vec::new() };
+            if ori.len() != (if need_ori { n_angles } else { 0 }) {
+                return Err(AttentionError::InvalidInput(format!(
+                    "front end level {l}: {} orientation planes for {n_angles} angles",
+                    ori.len()
+                )));
+            }
+            for (k, p) in planes.chain(ori).enumerate() {
+                let got = p.map(|p| p.size());
+                if got != Some(want) {
+                    return Err(AttentionError::InvalidInput(format!(
+                        "front end level {l}, plane {k}: {got:?}, the level is {}x{}",
+                        want.0, want.1
+                    )));
+                }
+            }
+        }
+        for &l in &self.used_levels {
+            for (dst, src) in self.pyr.opp.iter_mut().zip(&front.opponency) {
+                dst[l].clone_from(&src[l]);
+            }
+            if need_ori {
+                for (dst, src) in self.pyr.ori[l].iter_mut().zip(&front.orientation[l]) {
+                    dst.clone_from(src);
+                }
+            }
+        }
+        let t2 = Instant::now();
+        self.rescale()?;
+        let t3 = Instant::now();
+        self.center_surround();
+        let t4 = Instant::now();
+        let (norm, comb) = self.normalize_and_combine()?;
+        self.timings = StageTimings {
+            pyramid: Duration::ZERO,
+            orientation: Duration::ZERO,
+            rescale: t3 - t2,
+            center_surround: t4 - t3,
+            normalization: norm,
+            combination: comb,
+        };
+        Ok(&self.saliency)
+    }
+
+    /// The pyramid levels the center-surround pairs read, ascending (2..=8 for the default
+    /// pairs).
+    pub fn used_levels(&self) -> &[usize] {
+        &self.used_levels
     }
 
     /// A pyramid level of a source (empty if that level is not computed).

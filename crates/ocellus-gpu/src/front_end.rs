@@ -1,0 +1,364 @@
+//! The per-pixel front end of the saliency pipeline on the GPU: the colour pyramids, the
+//! opponency planes and the Gabor energies of the levels the center-surround pairs read, in
+//! one command buffer per frame, read back in one copy.
+
+use crate::{GpuContext, GpuError, Result};
+use ocellus_attention::config::{ChannelKind, GaborBorder, OpponencyStage};
+use ocellus_attention::gabor::kernel_2d;
+use ocellus_attention::saliency::FrontEnd;
+use ocellus_attention::SaliencyEngine;
+use ocellus_image::Plane;
+use std::sync::mpsc;
+use wgpu::util::DeviceExt;
+
+/// Angles the Gabor shader holds at once (its accumulator array).
+const MAX_ANGLES: usize = 8;
+
+/// The shader programs, in the order of [`Program`].
+const SHADERS: [(&str, &str, &str); 5] = [
+    ("unpack", include_str!("shaders/unpack.wgsl"), "main"),
+    ("pyr_vertical", include_str!("shaders/pyr_down.wgsl"), "vertical"),
+    ("pyr_horizontal", include_str!("shaders/pyr_down.wgsl"), "horizontal"),
+    ("opponency", include_str!("shaders/opponency.wgsl"), "main"),
+    ("gabor", include_str!("shaders/gabor.wgsl"), "main"),
+];
+
+#[derive(Clone, Copy)]
+enum Program {
+    Unpack = 0,
+    PyrVertical = 1,
+    PyrHorizontal = 2,
+    Opponency = 3,
+    Gabor = 4,
+}
+
+/// One dispatch: its program, bindings and workgroup counts.
+struct Pass {
+    program: Program,
+    bind_group: wgpu::BindGroup,
+    groups: [u32; 3],
+}
+
+/// The GPU front end for frames of one size and one saliency configuration.
+pub struct GpuFrontEnd {
+    ctx: GpuContext,
+    width: usize,
+    height: usize,
+    sizes: Vec<(usize, usize)>,
+    used: Vec<usize>,
+    n_angles: usize,
+    pipelines: Vec<wgpu::ComputePipeline>,
+    passes: Vec<Pass>,
+    input: wgpu::Buffer,
+    /// Source buffer, bytes, offset in `staging`.
+    copies: Vec<(wgpu::Buffer, u64, u64)>,
+    staging: wgpu::Buffer,
+    bytes: Vec<u8>,
+}
+
+impl std::fmt::Debug for GpuFrontEnd {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GpuFrontEnd")
+            .field("adapter", &self.ctx.describe())
+            .field("size", &(self.width, self.height))
+            .field("levels", &self.used)
+            .finish_non_exhaustive()
+    }
+}
+
+fn groups(n: usize, per: usize) -> u32 {
+    n.div_ceil(per).max(1) as u32
+}
+
+impl GpuFrontEnd {
+    /// Builds the front end of `engine` (its frame size, levels and configuration) on `ctx`.
+    /// The configuration must compute opponency at each level (`opponency_at = each_level`,
+    /// as the `ace2009` preset), use only the intensity, colour and orientation channels,
+    /// clamp the Gabor border, and have at most 8 angles; anything else is
+    /// [`GpuError::Unsupported`].
+    pub fn new(ctx: &GpuContext, engine: &SaliencyEngine) -> Result<Self> {
+        let cfg = engine.config();
+        if cfg.opponency_at != OpponencyStage::EachLevel {
+            return Err(GpuError::Unsupported(format!(
+                "opponency at {:?} (the GPU front end computes it at each level, as the ace2009 preset)",
+                cfg.opponency_at
+            )));
+        }
+        if let Some(c) = cfg
+            .channels
+            .iter()
+            .find(|c| !matches!(c.kind, ChannelKind::Intensity | ChannelKind::Color | ChannelKind::Orientation))
+        {
+            return Err(GpuError::Unsupported(format!(
+                "channel {:?} (intensity, colour and orientation only)",
+                c.kind
+            )));
+        }
+        let with_ori = cfg.channels.iter().any(|c| c.kind == ChannelKind::Orientation);
+        let n_angles = if with_ori { cfg.gabor.angles_deg.len() } else { 0 };
+        if with_ori && cfg.gabor.border != GaborBorder::Clamp {
+            return Err(GpuError::Unsupported(format!("Gabor border {:?} (clamp only)", cfg.gabor.border)));
+        }
+        if n_angles > MAX_ANGLES {
+            return Err(GpuError::Unsupported(format!("{n_angles} Gabor angles (at most {MAX_ANGLES})")));
+        }
+        let (width, height) = engine.frame_size();
+        let sizes = engine.level_sizes().to_vec();
+        let used = engine.used_levels().to_vec();
+        let top = sizes.len() - 1;
+        let input_bytes = (3 * width * height).div_ceil(4) * 4;
+        let largest = 4 * (width * height).max(input_bytes / 4) as u64;
+        if largest > ctx.limits().max_storage_buffer_binding_size as u64 || largest > ctx.limits().max_buffer_size {
+            return Err(GpuError::InvalidInput(format!(
+                "a {width}x{height} frame needs storage buffers of {largest} bytes; this device binds at most {}",
+                ctx.limits().max_storage_buffer_binding_size
+            )));
+        }
+
+        let device = &ctx.device;
+        let pipelines: Vec<wgpu::ComputePipeline> = SHADERS
+            .iter()
+            .map(|(label, source, entry)| {
+                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(label),
+                    source: wgpu::ShaderSource::Wgsl((*source).into()),
+                });
+                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(label),
+                    layout: None,
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                })
+            })
+            .collect();
+        let storage = |n: usize, label: &str| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 4 * n.max(1) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let init = |label: &str, contents: &[u8], usage: wgpu::BufferUsages| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let uniform = |words: [u32; 8]| init("dims", bytemuck::cast_slice(&words), wgpu::BufferUsages::UNIFORM);
+        let bind = |program: Program, buffers: &[&wgpu::Buffer]| {
+            let layout = pipelines[program as usize].get_bind_group_layout(0);
+            let entries: Vec<wgpu::BindGroupEntry> = buffers
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+                .collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &layout, entries: &entries })
+        };
+
+        let input = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("rgb8"),
+            size: input_bytes as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let rgb: Vec<Vec<wgpu::Buffer>> =
+            (0..3).map(|_| sizes.iter().map(|&(w, h)| storage(w * h, "colour level")).collect()).collect();
+        let tmp = storage((0..top).map(|l| sizes[l].0 * sizes[l + 1].1).max().unwrap_or(1), "pyramid rows");
+        let mut passes = Vec::new();
+
+        let n = width * height;
+        let blocks = n.div_ceil(256);
+        let unpack_dims = uniform([n as u32, 0, 0, 0, 0, 0, 0, 0]);
+        passes.push(Pass {
+            program: Program::Unpack,
+            bind_group: bind(Program::Unpack, &[&unpack_dims, &input, &rgb[0][0], &rgb[1][0], &rgb[2][0]]),
+            groups: [blocks.min(65535) as u32, blocks.div_ceil(65535) as u32, 1],
+        });
+
+        // Tap tables from the CPU's own rule (PyramidKernel::taps_for), padded with zero
+        // weights to the kernel's length.
+        let k = cfg.pyramid.taps.len().max(3);
+        let table = |n_out: usize, n_in: usize| -> Vec<u32> {
+            let mut taps = Vec::new();
+            let mut words = Vec::with_capacity(2 * k * n_out);
+            for j in 0..n_out {
+                cfg.pyramid.taps_for(j, n_in, &mut taps);
+                for t in 0..k {
+                    let (i, w) = taps.get(t).copied().unwrap_or((0, 0.0));
+                    words.extend([i as u32, w.to_bits()]);
+                }
+            }
+            words
+        };
+        for l in 0..top {
+            let ((wi, hi), (wo, ho)) = (sizes[l], sizes[l + 1]);
+            let vt = init("vertical taps", bytemuck::cast_slice(&table(ho, hi)), wgpu::BufferUsages::STORAGE);
+            let ht = init("horizontal taps", bytemuck::cast_slice(&table(wo, wi)), wgpu::BufferUsages::STORAGE);
+            let vd = uniform([wi as u32, hi as u32, wi as u32, ho as u32, k as u32, 0, 0, 0]);
+            let hd = uniform([wi as u32, ho as u32, wo as u32, ho as u32, k as u32, 0, 0, 0]);
+            for c in 0..3 {
+                passes.push(Pass {
+                    program: Program::PyrVertical,
+                    bind_group: bind(Program::PyrVertical, &[&vd, &rgb[c][l], &vt, &tmp]),
+                    groups: [groups(wi, 64), groups(ho, 4), 1],
+                });
+                passes.push(Pass {
+                    program: Program::PyrHorizontal,
+                    bind_group: bind(Program::PyrHorizontal, &[&hd, &tmp, &ht, &rgb[c][l + 1]]),
+                    groups: [groups(wo, 64), groups(ho, 4), 1],
+                });
+            }
+        }
+
+        let weights = cfg.intensity.weights();
+        let threshold = cfg.color_threshold;
+        let kernels: Vec<f32> = if with_ori {
+            let size = cfg.gabor.size;
+            let planes: Vec<[Vec<f32>; 2]> = cfg
+                .gabor
+                .angles_deg
+                .iter()
+                .map(|&a| [kernel_2d(&cfg.gabor, a, 0.0), kernel_2d(&cfg.gabor, a, std::f64::consts::FRAC_PI_2)])
+                .collect();
+            (0..size * size).flat_map(|t| planes.iter().flat_map(move |[e, o]| [e[t], o[t]])).collect()
+        } else {
+            vec![0.0; 2]
+        };
+        let kernels = init("gabor kernels", bytemuck::cast_slice(&kernels), wgpu::BufferUsages::STORAGE);
+        let mut copies = Vec::new();
+        let mut offset = 0u64;
+        for &l in &used {
+            let (w, h) = sizes[l];
+            let opp: Vec<wgpu::Buffer> = ["intensity", "red-green", "blue-yellow"].map(|s| storage(w * h, s)).into();
+            let dims = uniform([
+                (w * h) as u32,
+                0,
+                0,
+                0,
+                weights[0].to_bits(),
+                weights[1].to_bits(),
+                weights[2].to_bits(),
+                threshold.to_bits(),
+            ]);
+            passes.push(Pass {
+                program: Program::Opponency,
+                bind_group: bind(
+                    Program::Opponency,
+                    &[&dims, &rgb[0][l], &rgb[1][l], &rgb[2][l], &opp[0], &opp[1], &opp[2]],
+                ),
+                groups: [groups(w * h, 256), 1, 1],
+            });
+            let bytes = 4 * (w * h) as u64;
+            for b in &opp {
+                copies.push((b.clone(), bytes, offset));
+                offset += bytes;
+            }
+            if with_ori {
+                let ori = storage(n_angles * w * h, "gabor energy");
+                let dims = uniform([w as u32, h as u32, cfg.gabor.size as u32, n_angles as u32, 0, 0, 0, 0]);
+                passes.push(Pass {
+                    program: Program::Gabor,
+                    bind_group: bind(Program::Gabor, &[&dims, &opp[0], &kernels, &ori]),
+                    groups: [groups(w, 16), groups(h, 16), 1],
+                });
+                copies.push((ori, n_angles as u64 * bytes, offset));
+                offset += n_angles as u64 * bytes;
+            }
+        }
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: offset.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self {
+            ctx: ctx.clone(),
+            width,
+            height,
+            sizes,
+            used,
+            n_angles,
+            pipelines,
+            passes,
+            input,
+            copies,
+            staging,
+            bytes: vec![0; input_bytes],
+        })
+    }
+
+    /// Runs the front end on an 8-bit RGB frame and writes the levels into `out` (see
+    /// [`FrontEnd`]; only the used levels are filled, the others left empty).
+    pub fn process(&mut self, frame: &Plane<[u8; 3]>, out: &mut FrontEnd) -> Result<()> {
+        if frame.size() != (self.width, self.height) {
+            return Err(GpuError::InvalidInput(format!(
+                "frame is {}x{}, the GPU front end was built for {}x{}",
+                frame.width(),
+                frame.height(),
+                self.width,
+                self.height
+            )));
+        }
+        let row_bytes = 3 * self.width;
+        for (y, row) in frame.rows().enumerate() {
+            self.bytes[y * row_bytes..(y + 1) * row_bytes].copy_from_slice(row.as_flattened());
+        }
+        let (device, queue) = (&self.ctx.device, &self.ctx.queue);
+        queue.write_buffer(&self.input, 0, &self.bytes);
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("front end") });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
+            for p in &self.passes {
+                pass.set_pipeline(&self.pipelines[p.program as usize]);
+                pass.set_bind_group(0, &p.bind_group, &[]);
+                pass.dispatch_workgroups(p.groups[0], p.groups[1], p.groups[2]);
+            }
+        }
+        for (src, bytes, offset) in &self.copies {
+            encoder.copy_buffer_to_buffer(src, 0, &self.staging, *offset, *bytes);
+        }
+        queue.submit([encoder.finish()]);
+        let (tx, rx) = mpsc::channel();
+        self.staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            // The receiver waits below; a send can only fail if it is gone.
+            let _ = tx.send(r);
+        });
+        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
+        rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+        {
+            let view = self.staging.get_mapped_range(..).map_err(|e| GpuError::Readback(e.to_string()))?;
+            let data: &[f32] = bytemuck::cast_slice(&view);
+            let n_levels = self.sizes.len();
+            for p in out.opponency.iter_mut() {
+                p.resize_with(n_levels, Plane::default);
+            }
+            out.orientation.resize_with(n_levels, Vec::new);
+            let mut at = 0usize;
+            let mut take = |dst: &mut Plane<f32>, (w, h): (usize, usize)| {
+                dst.resize(w, h);
+                for (y, row) in data[at..at + w * h].chunks_exact(w.max(1)).enumerate() {
+                    dst.row_mut(y).copy_from_slice(row);
+                }
+                at += w * h;
+            };
+            for &l in &self.used {
+                let size = self.sizes[l];
+                for k in 0..3 {
+                    take(&mut out.opponency[k][l], size);
+                }
+                let ori = &mut out.orientation[l];
+                ori.resize_with(self.n_angles, Plane::default);
+                for plane in ori.iter_mut() {
+                    take(plane, size);
+                }
+            }
+        }
+        self.staging.unmap();
+        Ok(())
+    }
+
+    /// The device this front end runs on.
+    pub fn context(&self) -> &GpuContext {
+        &self.ctx
+    }
+}
