@@ -108,7 +108,7 @@ impl GpuFrontEnd {
         let top = sizes.len() - 1;
         let input_bytes = (3 * width * height).div_ceil(4) * 4;
         let largest = 4 * (width * height).max(input_bytes / 4) as u64;
-        if largest > ctx.limits().max_storage_buffer_binding_size as u64 || largest > ctx.limits().max_buffer_size {
+        if largest > ctx.limits().max_storage_buffer_binding_size || largest > ctx.limits().max_buffer_size {
             return Err(GpuError::InvalidInput(format!(
                 "a {width}x{height} frame needs storage buffers of {largest} bytes; this device binds at most {}",
                 ctx.limits().max_storage_buffer_binding_size
