@@ -549,3 +549,24 @@ fn calibrate_two_cameras_then_triangulate_their_matches() {
         }
     }
 }
+
+#[test]
+fn saliency_on_the_gpu_writes_the_cpu_maps() {
+    // The GPU front end (lavapipe where there is no GPU; scripts/setup.sh installs it).
+    let img = ocellus_testdata::asset("chelsea.png");
+    let (gpu, cpu) = (tmpdir("sal-gpu"), tmpdir("sal-cpu"));
+    for (out, extra) in [(&gpu, Some("--gpu")), (&cpu, None)] {
+        let o = ocellus().args(["saliency", "--out"]).arg(out).arg(&img).args(extra).output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let read = |d: &PathBuf| ocellus_io::npy::read(d.join("chelsea.saliency.npy")).unwrap();
+    let (g, c) = (read(&gpu), read(&cpu));
+    assert_eq!(g.shape, c.shape);
+    let peak = c.data.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = g.data.iter().zip(&c.data).fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(diff <= 1e-4 * peak, "{diff} of {peak}");
+    // A preset the GPU front end does not do is refused by name.
+    let o = ocellus().args(["saliency", "--gpu", "--preset", "stb", "--out"]).arg(&gpu).arg(&img).output().unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("not supported on the GPU backend"));
+}

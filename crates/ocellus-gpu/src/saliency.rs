@@ -44,6 +44,12 @@ impl GpuSaliencyEngine {
         &self.cpu
     }
 
+    /// The CPU engine, mutable (for its upsampled map, which reuses a buffer, and the spatial
+    /// prior).
+    pub fn engine_mut(&mut self) -> &mut SaliencyEngine {
+        &mut self.cpu
+    }
+
     /// Wall time of the last frame's GPU front end (upload, dispatches, readback), and the
     /// CPU stages' timings (whose pyramid and orientation entries read zero).
     pub fn timings(&self) -> (Duration, StageTimings) {

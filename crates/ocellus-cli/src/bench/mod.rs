@@ -2,6 +2,7 @@
 
 mod attention;
 mod geometry;
+mod gpu;
 mod logpolar;
 mod odometry;
 mod planning;
@@ -40,6 +41,10 @@ pub enum Target {
     /// The self-organizing retina: ms per gradient evaluation and per solver iteration for
     /// both of the seed's experiments at their sizes, all threads and one; peak memory.
     Retina,
+    /// The saliency map (ace2009) with the GPU front end: ms per frame end to end (upload,
+    /// GPU, readback, the CPU's map-level stages), the front end alone, the CPU engine on the
+    /// same frames, and the largest difference between the two maps.
+    Gpu,
 }
 
 /// Arguments of `ocellus bench`.
@@ -51,17 +56,17 @@ pub struct BenchArgs {
     #[arg(long)]
     pub json: bool,
     /// Frames timed on one thread (the median is reported) [default: 300; planning: at least
-    /// 100 decisions]. Saliency, attention and planning only. Range: 1..=100000.
+    /// 100 decisions; gpu: 50]. Saliency, gpu, attention and planning only. Range: 1..=100000.
     #[arg(long, value_parser = ranges::within(1usize, 100_000))]
     pub frames: Option<usize>,
     /// Frame width in pixels (the built-in images are resized to it) [default: 640].
-    /// Saliency only. Range: 32..=8192.
+    /// Saliency and gpu only. Range: 32..=8192.
     #[arg(long, value_parser = ranges::within(32u32, 8192))]
     pub width: Option<u32>,
-    /// Frame height in pixels [default: 480]. Saliency only. Range: 32..=8192.
+    /// Frame height in pixels [default: 480]. Saliency and gpu only. Range: 32..=8192.
     #[arg(long, value_parser = ranges::within(32u32, 8192))]
     pub height: Option<u32>,
-    /// Use this image (resized) instead of the built-in ones. Saliency only.
+    /// Use this image (resized) instead of the built-in ones. Saliency and gpu only.
     #[arg(long)]
     pub image: Option<PathBuf>,
     /// Presets to measure (default: ace2009 and stb). Saliency only.
@@ -91,6 +96,7 @@ impl BenchArgs {
             Target::Planning => &["--frames", "--backend"],
             Target::Geometry | Target::Odometry | Target::Logpolar => &["--backend"],
             Target::Tracking | Target::Retina => &[],
+            Target::Gpu => &["--frames", "--width", "--height", "--image"],
         };
         let unused: Vec<&str> = given.iter().filter(|(n, g)| *g && !used.contains(n)).map(|(n, _)| *n).collect();
         if !unused.is_empty() {
@@ -121,6 +127,7 @@ pub fn run(a: BenchArgs) -> Result<()> {
         Target::Logpolar => return logpolar::run(a.json, backend),
         Target::Tracking => return tracking::run(a.json),
         Target::Retina => return retina::run(a.json),
+        Target::Gpu => return gpu::run(&a, a.frames.unwrap_or(50)),
         Target::Saliency => {}
     }
     saliency::run(&a, backend, n)

@@ -11,7 +11,7 @@ use ocellus_image::Backend;
 use serde_json::json;
 use std::time::{Duration, Instant};
 
-fn frames(a: &BenchArgs) -> Result<Vec<RgbImage>> {
+pub(super) fn frames(a: &BenchArgs) -> Result<Vec<RgbImage>> {
     let (width, height) = a.size();
     // Decoded as every command decodes (format checks, memory budget); resized bilinearly
     // channel by channel (the content only has to be real photographs).
