@@ -3,6 +3,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
+# The GPU backend's conformance tests run on Mesa's software Vulkan driver (lavapipe), the
+# same on every machine, unless the caller names a driver.
+if [ -z "${VK_DRIVER_FILES:-}" ]; then
+  lvp=$(ls /usr/share/vulkan/icd.d/lvp_icd*.json 2>/dev/null | head -n 1 || true)
+  if [ -n "$lvp" ]; then export VK_DRIVER_FILES="$lvp"; fi
+fi
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
 set +e

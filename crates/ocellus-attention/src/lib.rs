@@ -64,6 +64,10 @@ pub enum AttentionError {
         /// Minimum side length.
         min_side: usize,
     },
+    /// The GPU backend could not be used: no adapter, a configuration it does not do, or a
+    /// build without the `gpu` feature (the message says which).
+    #[error("GPU backend: {0}")]
+    Gpu(String),
     /// Other unusable input (maps, priors).
     #[error("invalid input: {0}")]
     InvalidInput(String),

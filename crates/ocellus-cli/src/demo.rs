@@ -34,8 +34,8 @@ pub fn run(a: DemoArgs) -> Result<()> {
         for (name, bytes) in assets::IMAGES {
             let path = src.join(name);
             std::fs::write(&path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
-            let r = saliency_cmd::process_one(&path, &cfg, &mut engine, None, &out, true)?;
-            let t = engine.as_ref().map(|e| e.cpu().timings().total().as_secs_f64() * 1e3).unwrap_or(0.0);
+            let r = saliency_cmd::process_one(&path, &cfg, &mut engine, &out, true)?;
+            let t = engine.as_ref().map(|e| e.timings().total().as_secs_f64() * 1e3).unwrap_or(0.0);
             if *preset == SaliencyConfig::PRESETS[0] {
                 peaks.push((path.clone(), r.peak_px));
             }

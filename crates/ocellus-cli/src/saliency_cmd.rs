@@ -5,7 +5,6 @@ use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use ocellus_attention::{SaliencyConfig, SaliencyEngine};
-use ocellus_gpu::{GpuContext, GpuSaliencyEngine};
 use ocellus_image::{convert, Plane};
 use std::path::{Path, PathBuf};
 
@@ -37,38 +36,14 @@ pub struct SaliencyArgs {
     /// and the order of the printed lines do not depend on it. Range: 0..=256.
     #[arg(long, default_value_t = 0, value_parser = crate::ranges::within(0usize, 256))]
     pub workers: usize,
-    /// Run the per-pixel front end (pyramids, opponency, Gabor energies) on the GPU
-    /// (`ocellus-gpu`: Vulkan, Metal or DX12; a software Vulkan driver works too), the
-    /// map-level stages on the CPU. The maps equal the CPU's within 1e-4 of their peak. The
-    /// configuration must compute opponency at each level (the ace2009 preset) with the
-    /// intensity, colour and orientation channels; 16-bit inputs are reduced to 8 bits.
+    /// Run the per-pixel front end (pyramids, opponency, Gabor energies) on the GPU through
+    /// wgpu (Vulkan, Metal or DX12; a software Vulkan driver works too, slowly), the
+    /// map-level stages on the CPU: `backend = "gpu"` of the configuration. The maps equal
+    /// the CPU's within 1e-4 of their peak. It needs opponency at each level (the ace2009
+    /// preset) and the intensity, colour and orientation channels only; 16-bit inputs are
+    /// reduced to 8 bits.
     #[arg(long, conflicts_with = "print_config")]
     pub gpu: bool,
-}
-
-/// The engine of one worker: the CPU's, or the GPU front end with the CPU's map stages.
-pub enum Engine {
-    /// All on the CPU.
-    Cpu(Box<SaliencyEngine>),
-    /// GPU front end.
-    Gpu(Box<GpuSaliencyEngine>),
-}
-
-impl Engine {
-    /// The CPU engine: the whole pipeline, or the map-level stages after the GPU.
-    pub fn cpu(&self) -> &SaliencyEngine {
-        match self {
-            Engine::Cpu(e) => e,
-            Engine::Gpu(g) => g.engine(),
-        }
-    }
-
-    fn cpu_mut(&mut self) -> &mut SaliencyEngine {
-        match self {
-            Engine::Cpu(e) => e,
-            Engine::Gpu(g) => g.engine_mut(),
-        }
-    }
 }
 
 /// What one image produced.
@@ -92,34 +67,20 @@ fn write_map(out: &Path, name: &str, map: &Plane<f32>, files: &mut Vec<PathBuf>)
 }
 
 /// Computes and writes the outputs of one image with `engine` (rebuilt when the size changes).
-/// With `gpu`, the engine runs its front end on that device.
 pub fn process_one(
     path: &Path,
     cfg: &SaliencyConfig,
-    engine: &mut Option<Engine>,
-    gpu: Option<&GpuContext>,
+    engine: &mut Option<SaliencyEngine>,
     out: &Path,
     conspicuity: bool,
 ) -> Result<SaliencyResult> {
     let img = crate::budget::read_image(path)?;
     let (w, h) = img.size();
-    let at = || format!("{}", path.display());
-    if engine.as_ref().map(|e| e.cpu().frame_size()) != Some((w, h)) {
-        *engine = Some(match gpu {
-            None => Engine::Cpu(Box::new(SaliencyEngine::new(cfg.clone(), w, h).with_context(at)?)),
-            Some(ctx) => Engine::Gpu(Box::new(GpuSaliencyEngine::new(ctx, cfg.clone(), w, h).with_context(at)?)),
-        });
+    if engine.as_ref().map(|e| e.frame_size()) != Some((w, h)) {
+        *engine = Some(SaliencyEngine::new(cfg.clone(), w, h).with_context(|| format!("{}", path.display()))?);
     }
-    match engine.as_mut() {
-        Some(Engine::Cpu(e)) => {
-            e.process(&img).with_context(at)?;
-        }
-        Some(Engine::Gpu(g)) => {
-            g.process(&img.to_u8()).with_context(at)?;
-        }
-        None => bail!("engine missing"),
-    }
-    let Some(e) = engine.as_mut().map(|e| e.cpu_mut()) else { bail!("engine missing") };
+    let Some(e) = engine.as_mut() else { bail!("engine missing") };
+    e.process(&img).with_context(|| format!("{}", path.display()))?;
     let stem = inputs::stem(path);
     let mut files = Vec::new();
     write_map(out, &format!("{stem}.saliency"), e.saliency(), &mut files)?;
@@ -144,12 +105,14 @@ pub fn process_one(
 
 /// Runs the subcommand.
 pub fn run(a: SaliencyArgs) -> Result<()> {
-    let cfg = config_file::load(&a.preset, a.config.as_deref())?;
+    let mut cfg = config_file::load(&a.preset, a.config.as_deref())?;
+    if a.gpu {
+        cfg.backend = ocellus_image::Backend::Gpu;
+    }
     if a.print_config {
         out!("{}", config_file::to_toml(&cfg)?);
         return Ok(());
     }
-    let gpu = if a.gpu { Some(GpuContext::new()?) } else { None };
     let files = inputs::collect_images(&a.images)?;
     inputs::output_stems(&files)?;
     inputs::check_out_dir(&a.out, &files)?;
@@ -170,11 +133,11 @@ pub fn run(a: SaliencyArgs) -> Result<()> {
     let r = ocellus_io::pipeline::run_ordered(
         ocellus_io::pipeline::PipelineConfig::with_workers(a.workers),
         move || -> Result<Option<&PathBuf>> { Ok(next.next()) },
-        || Ok(None::<Engine>),
+        || Ok(None::<SaliencyEngine>),
         |engine, _, f| {
-            let r = process_one(f, &cfg, engine, gpu.as_ref(), &a.out, a.conspicuity);
+            let r = process_one(f, &cfg, engine, &a.out, a.conspicuity);
             let timings = engine.as_ref().map(|e| {
-                let t = e.cpu().timings();
+                let t = e.timings();
                 let parts: Vec<String> =
                     t.stages().iter().map(|(n, d)| format!("{n} {:.3}", d.as_secs_f64() * 1e3)).collect();
                 format!("  timings ms: {}; total {:.3}", parts.join(", "), t.total().as_secs_f64() * 1e3)

@@ -41,6 +41,17 @@ impl GpuContext {
         Ok(Self { device, queue, info, limits })
     }
 
+    /// One device for the whole process, opened on first use ([`Self::new`]); engines built
+    /// later share it instead of each opening an adapter (tens of milliseconds, and memory).
+    /// A failure is remembered too: every later call returns the same error.
+    pub fn shared() -> Result<Self> {
+        static SHARED: std::sync::OnceLock<std::result::Result<GpuContext, String>> = std::sync::OnceLock::new();
+        match SHARED.get_or_init(|| Self::new().map_err(|e| e.to_string())) {
+            Ok(c) => Ok(c.clone()),
+            Err(e) => Err(GpuError::NoAdapter(e.clone())),
+        }
+    }
+
     /// The adapter: name, backend, driver, and whether it is a CPU (software) device.
     pub fn adapter_info(&self) -> &wgpu::AdapterInfo {
         &self.info

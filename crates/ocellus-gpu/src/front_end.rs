@@ -3,16 +3,13 @@
 //! one command buffer per frame, read back in one copy.
 
 use crate::{GpuContext, GpuError, Result};
-use ocellus_attention::config::{ChannelKind, GaborBorder, OpponencyStage};
-use ocellus_attention::gabor::kernel_2d;
-use ocellus_attention::saliency::FrontEnd;
-use ocellus_attention::SaliencyEngine;
+use ocellus_image::pyramid::PyramidKernel;
 use ocellus_image::Plane;
 use std::sync::mpsc;
 use wgpu::util::DeviceExt;
 
 /// Angles the Gabor shader holds at once (its accumulator array).
-const MAX_ANGLES: usize = 8;
+pub const MAX_ANGLES: usize = 8;
 
 /// The shader programs, in the order of [`Program`].
 const SHADERS: [(&str, &str, &str); 5] = [
@@ -39,7 +36,29 @@ struct Pass {
     groups: [u32; 3],
 }
 
-/// The GPU front end for frames of one size and one saliency configuration.
+/// What the front end computes, in plain terms; the saliency engine (`ocellus-attention`,
+/// feature `gpu`) fills it from its configuration.
+#[derive(Clone, Debug)]
+pub struct FrontEndSpec {
+    /// Size of every pyramid level (width, height), level 0 (the frame) first.
+    pub level_sizes: Vec<(usize, usize)>,
+    /// Levels whose opponency planes (and Gabor energies) are computed and read back.
+    pub used_levels: Vec<usize>,
+    /// The pyramid's low-pass kernel; its [`PyramidKernel::taps_for`] rule builds the tap
+    /// tables, so borders are truncated and renormalized exactly as on the CPU.
+    pub pyramid: PyramidKernel,
+    /// Intensity weights of r, g, b (`I = w . (r, g, b)`).
+    pub intensity_weights: [f32; 3],
+    /// Opponency is 0 where max(r, g, b) is below this (values in [0, 1]).
+    pub color_threshold: f32,
+    /// Gabor kernels per angle, (even, odd), each `gabor_size` x `gabor_size` row-major,
+    /// correlated with edge pixels repeated outward; empty: no orientation channel.
+    pub gabor: Vec<[Vec<f32>; 2]>,
+    /// Side of the Gabor kernels, pixels (odd).
+    pub gabor_size: usize,
+}
+
+/// The GPU front end for frames of one size.
 pub struct GpuFrontEnd {
     ctx: GpuContext,
     width: usize,
@@ -71,40 +90,36 @@ fn groups(n: usize, per: usize) -> u32 {
 }
 
 impl GpuFrontEnd {
-    /// Builds the front end of `engine` (its frame size, levels and configuration) on `ctx`.
-    /// The configuration must compute opponency at each level (`opponency_at = each_level`,
-    /// as the `ace2009` preset), use only the intensity, colour and orientation channels,
-    /// clamp the Gabor border, and have at most 8 angles; anything else is
-    /// [`GpuError::Unsupported`].
-    pub fn new(ctx: &GpuContext, engine: &SaliencyEngine) -> Result<Self> {
-        let cfg = engine.config();
-        if cfg.opponency_at != OpponencyStage::EachLevel {
-            return Err(GpuError::Unsupported(format!(
-                "opponency at {:?} (the GPU front end computes it at each level, as the ace2009 preset)",
-                cfg.opponency_at
-            )));
+    /// Builds the front end of `spec` on `ctx`: pipelines, buffers and the command list of a
+    /// frame. Errors for an inconsistent spec (no levels, a used level past the top, more
+    /// than [`MAX_ANGLES`] angles, kernels of the wrong size) or a frame whose buffers exceed
+    /// the device's limits.
+    pub fn new(ctx: &GpuContext, spec: &FrontEndSpec) -> Result<Self> {
+        let Some(&(width, height)) = spec.level_sizes.first() else {
+            return Err(GpuError::InvalidInput("no pyramid levels".into()));
+        };
+        let sizes = spec.level_sizes.clone();
+        let used = spec.used_levels.clone();
+        if let Some(l) = used.iter().find(|&&l| l >= sizes.len()) {
+            return Err(GpuError::InvalidInput(format!("level {l} of a {}-level pyramid", sizes.len())));
         }
-        if let Some(c) = cfg
-            .channels
-            .iter()
-            .find(|c| !matches!(c.kind, ChannelKind::Intensity | ChannelKind::Color | ChannelKind::Orientation))
-        {
-            return Err(GpuError::Unsupported(format!(
-                "channel {:?} (intensity, colour and orientation only)",
-                c.kind
-            )));
-        }
-        let with_ori = cfg.channels.iter().any(|c| c.kind == ChannelKind::Orientation);
-        let n_angles = if with_ori { cfg.gabor.angles_deg.len() } else { 0 };
-        if with_ori && cfg.gabor.border != GaborBorder::Clamp {
-            return Err(GpuError::Unsupported(format!("Gabor border {:?} (clamp only)", cfg.gabor.border)));
-        }
+        let n_angles = spec.gabor.len();
+        let with_ori = n_angles > 0;
         if n_angles > MAX_ANGLES {
             return Err(GpuError::Unsupported(format!("{n_angles} Gabor angles (at most {MAX_ANGLES})")));
         }
-        let (width, height) = engine.frame_size();
-        let sizes = engine.level_sizes().to_vec();
-        let used = engine.used_levels().to_vec();
+        let taps = spec.gabor_size * spec.gabor_size;
+        if with_ori
+            && (spec.gabor_size.is_multiple_of(2) || spec.gabor.iter().any(|[e, o]| e.len() != taps || o.len() != taps))
+        {
+            return Err(GpuError::InvalidInput(format!(
+                "Gabor kernels must be {0}x{0} with an odd side",
+                spec.gabor_size
+            )));
+        }
+        if spec.pyramid.taps.is_empty() {
+            return Err(GpuError::InvalidInput("an empty pyramid kernel".into()));
+        }
         let top = sizes.len() - 1;
         let input_bytes = (3 * width * height).div_ceil(4) * 4;
         let largest = 4 * (width * height).max(input_bytes / 4) as u64;
@@ -177,12 +192,12 @@ impl GpuFrontEnd {
 
         // Tap tables from the CPU's own rule (PyramidKernel::taps_for), padded with zero
         // weights to the kernel's length.
-        let k = cfg.pyramid.taps.len().max(3);
+        let k = spec.pyramid.taps.len().max(3);
         let table = |n_out: usize, n_in: usize| -> Vec<u32> {
             let mut taps = Vec::new();
             let mut words = Vec::with_capacity(2 * k * n_out);
             for j in 0..n_out {
-                cfg.pyramid.taps_for(j, n_in, &mut taps);
+                spec.pyramid.taps_for(j, n_in, &mut taps);
                 for t in 0..k {
                     let (i, w) = taps.get(t).copied().unwrap_or((0, 0.0));
                     words.extend([i as u32, w.to_bits()]);
@@ -210,17 +225,10 @@ impl GpuFrontEnd {
             }
         }
 
-        let weights = cfg.intensity.weights();
-        let threshold = cfg.color_threshold;
+        let weights = spec.intensity_weights;
+        let threshold = spec.color_threshold;
         let kernels: Vec<f32> = if with_ori {
-            let size = cfg.gabor.size;
-            let planes: Vec<[Vec<f32>; 2]> = cfg
-                .gabor
-                .angles_deg
-                .iter()
-                .map(|&a| [kernel_2d(&cfg.gabor, a, 0.0), kernel_2d(&cfg.gabor, a, std::f64::consts::FRAC_PI_2)])
-                .collect();
-            (0..size * size).flat_map(|t| planes.iter().flat_map(move |[e, o]| [e[t], o[t]])).collect()
+            (0..taps).flat_map(|t| spec.gabor.iter().flat_map(move |[e, o]| [e[t], o[t]])).collect()
         } else {
             vec![0.0; 2]
         };
@@ -255,7 +263,7 @@ impl GpuFrontEnd {
             }
             if with_ori {
                 let ori = storage(n_angles * w * h, "gabor energy");
-                let dims = uniform([w as u32, h as u32, cfg.gabor.size as u32, n_angles as u32, 0, 0, 0, 0]);
+                let dims = uniform([w as u32, h as u32, spec.gabor_size as u32, n_angles as u32, 0, 0, 0, 0]);
                 passes.push(Pass {
                     program: Program::Gabor,
                     bind_group: bind(Program::Gabor, &[&dims, &opp[0], &kernels, &ori]),
@@ -287,9 +295,15 @@ impl GpuFrontEnd {
         })
     }
 
-    /// Runs the front end on an 8-bit RGB frame and writes the levels into `out` (see
-    /// [`FrontEnd`]; only the used levels are filled, the others left empty).
-    pub fn process(&mut self, frame: &Plane<[u8; 3]>, out: &mut FrontEnd) -> Result<()> {
+    /// Runs the front end on an 8-bit RGB frame: `opponency[k][l]` (k: intensity, red-green,
+    /// blue-yellow) and `orientation[l][a]` receive level `l`'s planes for every used level;
+    /// the outer vectors grow to the pyramid's height, other levels are left as they are.
+    pub fn process(
+        &mut self,
+        frame: &Plane<[u8; 3]>,
+        opponency: &mut [Vec<Plane<f32>>; 3],
+        orientation: &mut Vec<Vec<Plane<f32>>>,
+    ) -> Result<()> {
         if frame.size() != (self.width, self.height) {
             return Err(GpuError::InvalidInput(format!(
                 "frame is {}x{}, the GPU front end was built for {}x{}",
@@ -329,10 +343,14 @@ impl GpuFrontEnd {
             let view = self.staging.get_mapped_range(..).map_err(|e| GpuError::Readback(e.to_string()))?;
             let data: &[f32] = bytemuck::cast_slice(&view);
             let n_levels = self.sizes.len();
-            for p in out.opponency.iter_mut() {
-                p.resize_with(n_levels, Plane::default);
+            for p in opponency.iter_mut() {
+                if p.len() < n_levels {
+                    p.resize_with(n_levels, Plane::default);
+                }
             }
-            out.orientation.resize_with(n_levels, Vec::new);
+            if orientation.len() < n_levels {
+                orientation.resize_with(n_levels, Vec::new);
+            }
             let mut at = 0usize;
             let mut take = |dst: &mut Plane<f32>, (w, h): (usize, usize)| {
                 dst.resize(w, h);
@@ -344,9 +362,9 @@ impl GpuFrontEnd {
             for &l in &self.used {
                 let size = self.sizes[l];
                 for k in 0..3 {
-                    take(&mut out.opponency[k][l], size);
+                    take(&mut opponency[k][l], size);
                 }
-                let ori = &mut out.orientation[l];
+                let ori = &mut orientation[l];
                 ori.resize_with(self.n_angles, Plane::default);
                 for plane in ori.iter_mut() {
                     take(plane, size);

@@ -1,27 +1,23 @@
-//! The GPU backend of ocellus (SPEC 9.2): the saliency front end on any GPU that wgpu reaches
+//! The GPU backend of ocellus (SPEC 9.2): compute shaders (WGSL) on any GPU that wgpu reaches
 //! (Vulkan, Metal, DX12), checked in CI on Mesa's software Vulkan driver (lavapipe).
 //!
-//! The seed ran the whole Itti-Koch pipeline in CUDA. Here the GPU runs the per-pixel front
-//! end, the stages whose cost grows with the frame: 8-bit RGB to float, the colour
-//! pyramids (levels 0..8, separable [1 5 10 10 5 1]/32 low-pass and decimation, truncated
-//! and renormalized kernels at the borders from the same tap rule as the CPU), intensity and
-//! colour opponency at the levels the center-surround pairs read, and the Gabor energies
-//! there (direct 19x19 correlation with the mean-removed unit-norm kernels). What remains
-//! works on 40x30 maps (rescaling to the map level, center-surround, N(.), combination) and
-//! runs on the CPU engine, fed through
-//! [`SaliencyEngine::process_front_end`](ocellus_attention::SaliencyEngine::process_front_end).
+//! [`GpuFrontEnd`] runs the per-pixel front end of the Itti-Koch saliency map, the stages whose
+//! cost grows with the frame: 8-bit RGB to float, the colour pyramids (levels 0..8, separable
+//! low-pass and decimation with the CPU's own truncated, renormalized border taps), intensity
+//! and colour opponency at the levels the center-surround pairs read, and the Gabor energies
+//! there (direct 2D correlation with the mean-removed, unit-norm kernels). The saliency
+//! engine of `ocellus-attention` selects it with `Backend::Gpu` (feature `gpu`) and runs the
+//! 40x30 map stages (rescaling, center-surround, N(.), combination) on the CPU.
 //!
-//! Tolerance: the GPU's levels and saliency map equal the CPU's within a relative error of
-//! [`TOLERANCE`] of each plane's largest magnitude (the sums run in another order, the Gabor
-//! bank is direct on the GPU and separable on the CPU, and GPUs may fuse multiply-adds).
+//! Tolerance: the GPU's planes equal the CPU's within a relative error of [`TOLERANCE`] of
+//! each plane's largest magnitude (sums run in another order, the Gabor bank is direct here
+//! and separable on the CPU, and GPUs may fuse multiply-adds).
 
 mod context;
 mod front_end;
-mod saliency;
 
 pub use context::GpuContext;
-pub use front_end::GpuFrontEnd;
-pub use saliency::GpuSaliencyEngine;
+pub use front_end::{FrontEndSpec, GpuFrontEnd, MAX_ANGLES};
 
 /// Largest difference between a GPU and a CPU plane, relative to the CPU plane's largest
 /// magnitude, that the tests accept.
@@ -38,7 +34,7 @@ pub enum GpuError {
     /// The adapter refused to open a device.
     #[error("the GPU adapter refused a device: {0}")]
     Device(String),
-    /// The configuration asks for something the GPU front end does not do.
+    /// The spec asks for something the GPU front end does not do.
     #[error("not supported on the GPU backend: {0}")]
     Unsupported(String),
     /// The frame does not fit this engine or the device's limits.
@@ -47,9 +43,6 @@ pub enum GpuError {
     /// Reading results back from the device failed.
     #[error("reading back from the GPU failed: {0}")]
     Readback(String),
-    /// The CPU part of the pipeline failed.
-    #[error(transparent)]
-    Attention(#[from] ocellus_attention::AttentionError),
 }
 
 /// Result type of this crate.

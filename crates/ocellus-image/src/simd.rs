@@ -33,6 +33,11 @@ pub enum Backend {
     /// AVX-512 F + BW + VL + DQ (x86-64), which implies AVX2 + FMA: every float kernel
     /// compiled for 512-bit registers; the hand-written integer kernels run their AVX2 form.
     Avx512,
+    /// The GPU, through wgpu, where a pipeline has a GPU path: the saliency engine's per-pixel
+    /// front end, with the `gpu` feature of `ocellus-attention`. Everything that runs on the
+    /// CPU meanwhile (the saliency map's level-4 stages, every other pipeline) uses the best
+    /// CPU backend, as `Auto`.
+    Gpu,
 }
 
 impl Backend {
@@ -49,11 +54,12 @@ impl Backend {
         }
     }
 
-    /// Turns `Auto` into a concrete backend; an unavailable one falls back to the best
-    /// available below it (`Avx512` to `Avx2` to `Sse41` to `Scalar`).
+    /// Turns `Auto` (and `Gpu`, for the CPU's kernels) into a concrete CPU backend; an
+    /// unavailable one falls back to the best available below it (`Avx512` to `Avx2` to
+    /// `Sse41` to `Scalar`).
     pub fn resolve(self) -> Backend {
         match self {
-            Backend::Auto => Backend::detect(),
+            Backend::Auto | Backend::Gpu => Backend::detect(),
             Backend::Avx512 if !avx512_available() => Backend::Avx2.resolve(),
             Backend::Avx2 if !avx2_available() => Backend::Sse41.resolve(),
             Backend::Sse41 if !sse41_available() => Backend::Scalar,
@@ -84,6 +90,9 @@ impl Backend {
 
     /// Short name, for reports.
     pub fn name(self) -> &'static str {
+        if self == Backend::Gpu {
+            return "gpu";
+        }
         match self.resolve() {
             Backend::Avx512 => "avx512",
             Backend::Avx2 => "avx2+fma",

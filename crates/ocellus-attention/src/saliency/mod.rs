@@ -44,17 +44,6 @@ pub enum Source {
     External(usize),
 }
 
-/// Pyramid levels computed outside a [`SaliencyEngine`] (see
-/// [`SaliencyEngine::process_front_end`]).
-#[derive(Clone, Debug, Default)]
-pub struct FrontEnd {
-    /// Intensity, red-green and blue-yellow, indexed `[channel][level]`; levels outside
-    /// [`SaliencyEngine::used_levels`] may be empty.
-    pub opponency: [Vec<Plane<f32>>; 3],
-    /// Gabor energy `M_theta`, indexed `[level][angle]` (angles in the configuration's order).
-    pub orientation: Vec<Vec<Plane<f32>>>,
-}
-
 /// The Gaussian pyramids of one frame, levels 0..=max_level; levels a source does not need
 /// stay empty.
 #[derive(Debug)]
@@ -115,6 +104,68 @@ pub struct SaliencyEngine {
     prior: Option<Plane<f32>>,
     upsampler: Option<Resampler>,
     timings: StageTimings,
+    /// The front end on the GPU (`Backend::Gpu`).
+    gpu: Option<GpuFront>,
+}
+
+#[cfg(feature = "gpu")]
+type GpuFront = ocellus_gpu::GpuFrontEnd;
+/// Without the `gpu` feature there is no GPU front end.
+#[cfg(not(feature = "gpu"))]
+#[derive(Debug)]
+enum GpuFront {}
+
+/// The GPU front end for `cfg` (see [`SaliencyEngine::new`]).
+#[cfg(feature = "gpu")]
+fn gpu_front(cfg: &SaliencyConfig, sizes: &[(usize, usize)], used: &[usize]) -> Result<GpuFront> {
+    let unsupported = |what: String| Err(AttentionError::Gpu(format!("not supported on the GPU backend: {what}")));
+    if cfg.opponency_at != OpponencyStage::EachLevel {
+        return unsupported(format!(
+            "opponency at {:?} (the GPU front end computes it at each level, as the ace2009 preset)",
+            cfg.opponency_at
+        ));
+    }
+    if let Some(c) = cfg
+        .channels
+        .iter()
+        .find(|c| !matches!(c.kind, ChannelKind::Intensity | ChannelKind::Color | ChannelKind::Orientation))
+    {
+        return unsupported(format!("channel {:?} (intensity, colour and orientation only)", c.kind));
+    }
+    let with_ori = cfg.channels.iter().any(|c| c.kind == ChannelKind::Orientation);
+    if with_ori && cfg.gabor.border != crate::config::GaborBorder::Clamp {
+        return unsupported(format!("Gabor border {:?} (clamp only)", cfg.gabor.border));
+    }
+    let gabor = if with_ori {
+        let psi = std::f64::consts::FRAC_PI_2;
+        cfg.gabor
+            .angles_deg
+            .iter()
+            .map(|&a| [crate::gabor::kernel_2d(&cfg.gabor, a, 0.0), crate::gabor::kernel_2d(&cfg.gabor, a, psi)])
+            .collect()
+    } else {
+        Vec::new()
+    };
+    let spec = ocellus_gpu::FrontEndSpec {
+        level_sizes: sizes.to_vec(),
+        used_levels: used.to_vec(),
+        pyramid: cfg.pyramid.clone(),
+        intensity_weights: cfg.intensity.weights(),
+        color_threshold: cfg.color_threshold,
+        gabor,
+        gabor_size: cfg.gabor.size,
+    };
+    let gpu_err = |e: ocellus_gpu::GpuError| AttentionError::Gpu(e.to_string());
+    let ctx = ocellus_gpu::GpuContext::shared().map_err(gpu_err)?;
+    ocellus_gpu::GpuFrontEnd::new(&ctx, &spec).map_err(gpu_err)
+}
+
+#[cfg(not(feature = "gpu"))]
+fn gpu_front(_: &SaliencyConfig, _: &[(usize, usize)], _: &[usize]) -> Result<GpuFront> {
+    Err(AttentionError::Gpu(
+        "this build has no GPU backend (build ocellus-attention with its `gpu` feature; ocellus-cli enables it by default)"
+            .into(),
+    ))
 }
 
 fn empty_pyr(n: usize) -> Vec<Plane<f32>> {
@@ -186,7 +237,9 @@ impl SaliencyEngine {
         // Order feature maps by sub-feature, then pair, for readable listings.
         let mut features = features;
         features.sort_by_key(|f| (f.subfeature, f.center, f.surround));
+        let gpu = if cfg.backend == Backend::Gpu { Some(gpu_front(&cfg, &sizes, &used_levels)?) } else { None };
         Ok(Self {
+            gpu,
             backend: cfg.backend.resolve(),
             width,
             height,
@@ -243,9 +296,16 @@ impl SaliencyEngine {
         self.sizes[self.cfg.map_level]
     }
 
-    /// The backend that runs the kernels.
+    /// The backend that runs the CPU's kernels (a concrete CPU backend, also when the front
+    /// end runs on the GPU).
     pub fn backend(&self) -> Backend {
         self.backend
+    }
+
+    /// Whether the front end (pyramids, opponency, Gabor energies) runs on the GPU
+    /// (`Backend::Gpu`); the map-level stages always run on the CPU.
+    pub fn on_gpu(&self) -> bool {
+        self.gpu.is_some()
     }
 
     /// Sets a spatial prior (top-down location bias, SPEC 1.8): the final saliency map is
@@ -312,10 +372,33 @@ impl SaliencyEngine {
             }
         }
         let t0 = Instant::now();
-        self.build_pyramids(frame, external)?;
-        let t1 = Instant::now();
-        self.build_orientations()?;
-        let t2 = Instant::now();
+        let (t1, t2) = match self.gpu.as_mut() {
+            None => {
+                self.build_pyramids(frame, external)?;
+                let t1 = Instant::now();
+                self.build_orientations()?;
+                (t1, Instant::now())
+            }
+            Some(g) => {
+                #[cfg(feature = "gpu")]
+                {
+                    let rgb8;
+                    let frame8 = match frame {
+                        RgbImage::U8(p) => p,
+                        RgbImage::F32(_) => {
+                            rgb8 = frame.to_u8();
+                            &rgb8
+                        }
+                    };
+                    g.process(frame8, &mut self.pyr.opp, &mut self.pyr.ori)
+                        .map_err(|e| AttentionError::Gpu(e.to_string()))?;
+                    let t = Instant::now();
+                    (t, t)
+                }
+                #[cfg(not(feature = "gpu"))]
+                match *g {}
+            }
+        };
         self.rescale()?;
         let t3 = Instant::now();
         self.center_surround();
@@ -474,74 +557,6 @@ impl SaliencyEngine {
             g.filter(self.backend, &self.pyr.opp[0][l], &mut self.pyr.ori[l])?;
         }
         Ok(())
-    }
-
-    /// Runs the rest of the pipeline (rescale, center-surround, N(.), combination) on
-    /// pyramid levels computed elsewhere, e.g. by the GPU backend (`ocellus-gpu`): the
-    /// intensity, red-green and blue-yellow levels and the Gabor energies of every level in
-    /// [`Self::used_levels`], each of that level's size. Only for configurations whose
-    /// channels are intensity, colour and orientation. The stage timings of the front end
-    /// (pyramid, orientation) read zero.
-    pub fn process_front_end(&mut self, front: &FrontEnd) -> Result<&Plane<f32>> {
-        if let Some(c) = self
-            .cfg
-            .channels
-            .iter()
-            .find(|c| !matches!(c.kind, ChannelKind::Intensity | ChannelKind::Color | ChannelKind::Orientation))
-        {
-            return Err(AttentionError::InvalidInput(format!(
-                "a precomputed front end carries intensity, colour and orientation only; the configuration has {:?}",
-                c.kind
-            )));
-        }
-        let n_angles = self.cfg.gabor.angles_deg.len();
-        let need_ori = self.gabor.is_some();
-        for &l in &self.used_levels {
-            let want = self.sizes[l];
-            let planes = front.opponency.iter().map(|p| p.get(l));
-            let ori = front.orientation.get(l).map(|v| v.iter().map(Some).collect::<Vec<_>>());
-            let ori = if need_ori { ori.unwrap_or_else(|| vec![None; n_angles]) } else { Vec::new() };
-            if ori.len() != (if need_ori { n_angles } else { 0 }) {
-                return Err(AttentionError::InvalidInput(format!(
-                    "front end level {l}: {} orientation planes for {n_angles} angles",
-                    ori.len()
-                )));
-            }
-            for (k, p) in planes.chain(ori).enumerate() {
-                let got = p.map(|p| p.size());
-                if got != Some(want) {
-                    return Err(AttentionError::InvalidInput(format!(
-                        "front end level {l}, plane {k}: {got:?}, the level is {}x{}",
-                        want.0, want.1
-                    )));
-                }
-            }
-        }
-        for &l in &self.used_levels {
-            for (dst, src) in self.pyr.opp.iter_mut().zip(&front.opponency) {
-                dst[l].clone_from(&src[l]);
-            }
-            if need_ori {
-                for (dst, src) in self.pyr.ori[l].iter_mut().zip(&front.orientation[l]) {
-                    dst.clone_from(src);
-                }
-            }
-        }
-        let t2 = Instant::now();
-        self.rescale()?;
-        let t3 = Instant::now();
-        self.center_surround();
-        let t4 = Instant::now();
-        let (norm, comb) = self.normalize_and_combine()?;
-        self.timings = StageTimings {
-            pyramid: Duration::ZERO,
-            orientation: Duration::ZERO,
-            rescale: t3 - t2,
-            center_surround: t4 - t3,
-            normalization: norm,
-            combination: comb,
-        };
-        Ok(&self.saliency)
     }
 
     /// The pyramid levels the center-surround pairs read, ascending (2..=8 for the default

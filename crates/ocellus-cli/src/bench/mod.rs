@@ -2,7 +2,6 @@
 
 mod attention;
 mod geometry;
-mod gpu;
 mod logpolar;
 mod odometry;
 mod planning;
@@ -41,10 +40,6 @@ pub enum Target {
     /// The self-organizing retina: ms per gradient evaluation and per solver iteration for
     /// both of the seed's experiments at their sizes, all threads and one; peak memory.
     Retina,
-    /// The saliency map (ace2009) with the GPU front end: ms per frame end to end (upload,
-    /// GPU, readback, the CPU's map-level stages), the front end alone, the CPU engine on the
-    /// same frames, and the largest difference between the two maps.
-    Gpu,
 }
 
 /// Arguments of `ocellus bench`.
@@ -56,24 +51,25 @@ pub struct BenchArgs {
     #[arg(long)]
     pub json: bool,
     /// Frames timed on one thread (the median is reported) [default: 300; planning: at least
-    /// 100 decisions; gpu: 50]. Saliency, gpu, attention and planning only. Range: 1..=100000.
+    /// 100 decisions; saliency on the gpu backend: 50]. Saliency, attention and planning only. Range: 1..=100000.
     #[arg(long, value_parser = ranges::within(1usize, 100_000))]
     pub frames: Option<usize>,
     /// Frame width in pixels (the built-in images are resized to it) [default: 640].
-    /// Saliency and gpu only. Range: 32..=8192.
+    /// Saliency only. Range: 32..=8192.
     #[arg(long, value_parser = ranges::within(32u32, 8192))]
     pub width: Option<u32>,
-    /// Frame height in pixels [default: 480]. Saliency and gpu only. Range: 32..=8192.
+    /// Frame height in pixels [default: 480]. Saliency only. Range: 32..=8192.
     #[arg(long, value_parser = ranges::within(32u32, 8192))]
     pub height: Option<u32>,
-    /// Use this image (resized) instead of the built-in ones. Saliency and gpu only.
+    /// Use this image (resized) instead of the built-in ones. Saliency only.
     #[arg(long)]
     pub image: Option<PathBuf>,
     /// Presets to measure (default: ace2009 and stb). Saliency only.
     #[arg(long, value_delimiter = ',')]
     pub preset: Vec<String>,
     /// Kernel build: auto, scalar, sse41, avx2 or avx512 (an unavailable one falls back to the best
-    /// below it) [default: auto]. Not for attention (it times the `attend` command).
+    /// below it), or gpu (saliency only: the front end on the GPU, the ace2009 preset by
+    /// default) [default: auto]. Not for attention (it times the `attend` command).
     #[arg(long)]
     pub backend: Option<String>,
 }
@@ -96,7 +92,6 @@ impl BenchArgs {
             Target::Planning => &["--frames", "--backend"],
             Target::Geometry | Target::Odometry | Target::Logpolar => &["--backend"],
             Target::Tracking | Target::Retina => &[],
-            Target::Gpu => &["--frames", "--width", "--height", "--image"],
         };
         let unused: Vec<&str> = given.iter().filter(|(n, g)| *g && !used.contains(n)).map(|(n, _)| *n).collect();
         if !unused.is_empty() {
@@ -115,10 +110,13 @@ impl BenchArgs {
 /// Runs the subcommand.
 pub fn run(a: BenchArgs) -> Result<()> {
     a.reject_unused()?;
-    let n = a.frames.unwrap_or(300);
+    let n = a.frames.unwrap_or(if a.backend.as_deref() == Some("gpu") { 50 } else { 300 });
     let backend_name = a.backend.as_deref().unwrap_or("auto");
     let backend: Backend = serde_json::from_value(json!(backend_name))
-        .map_err(|_| anyhow::anyhow!("unknown backend '{backend_name}' (auto, scalar, sse41, avx2, avx512)"))?;
+        .map_err(|_| anyhow::anyhow!("unknown backend '{backend_name}' (auto, scalar, sse41, avx2, avx512, gpu)"))?;
+    if backend == Backend::Gpu && !matches!(a.target, Target::Saliency) {
+        bail!("--backend gpu is for bench saliency only (the other pipelines have no GPU path)");
+    }
     match a.target {
         Target::Attention => return attention::run(a.json, n),
         Target::Planning => return planning::run(a.json, backend, n.max(100)),
@@ -127,7 +125,6 @@ pub fn run(a: BenchArgs) -> Result<()> {
         Target::Logpolar => return logpolar::run(a.json, backend),
         Target::Tracking => return tracking::run(a.json),
         Target::Retina => return retina::run(a.json),
-        Target::Gpu => return gpu::run(&a, a.frames.unwrap_or(50)),
         Target::Saliency => {}
     }
     saliency::run(&a, backend, n)

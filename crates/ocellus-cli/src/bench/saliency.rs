@@ -11,7 +11,7 @@ use ocellus_image::Backend;
 use serde_json::json;
 use std::time::{Duration, Instant};
 
-pub(super) fn frames(a: &BenchArgs) -> Result<Vec<RgbImage>> {
+fn frames(a: &BenchArgs) -> Result<Vec<RgbImage>> {
     let (width, height) = a.size();
     // Decoded as every command decodes (format checks, memory budget); resized bilinearly
     // channel by channel (the content only has to be real photographs).
@@ -53,13 +53,18 @@ fn bench_preset(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize) -> Result<s
 
     // Throughput with 1 thread and with all threads, same harness, alternated three times
     // so that both see the same machine load; medians.
+    // On the GPU backend the engines share one device: throughput is the single engine's.
     let threads = rayon::current_num_threads();
-    let (mut one, mut all) = (Vec::new(), Vec::new());
-    for _ in 0..3 {
-        one.push(throughput(cfg, frames, 1, n)?);
-        all.push(throughput(cfg, frames, threads, n.max(threads * 100))?);
-    }
-    let (fps_1, fps_all) = (median(&mut one), median(&mut all));
+    let (fps_1, fps_all) = if cfg.backend == Backend::Gpu {
+        (1e3 / ms, 1e3 / ms)
+    } else {
+        let (mut one, mut all) = (Vec::new(), Vec::new());
+        for _ in 0..3 {
+            one.push(throughput(cfg, frames, 1, n)?);
+            all.push(throughput(cfg, frames, threads, n.max(threads * 100))?);
+        }
+        (median(&mut one), median(&mut all))
+    };
     Ok(json!({
         "ms_per_frame_1thread": ms,
         "ms_per_frame_1thread_mean": mean_ms,
@@ -110,11 +115,43 @@ fn throughput(cfg: &SaliencyConfig, frames: &[RgbImage], threads: usize, n: usiz
     Ok(n as f64 / elapsed.as_secs_f64())
 }
 
+/// The device the front end runs on: the GPU adapter, or the CPU's model name.
+fn device(backend: Backend) -> Result<String> {
+    #[cfg(feature = "gpu")]
+    if backend == Backend::Gpu {
+        return Ok(ocellus_gpu::GpuContext::shared()?.describe());
+    }
+    let _ = backend;
+    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let model = cpuinfo.lines().find_map(|l| l.strip_prefix("model name")?.split_once(':').map(|(_, m)| m.trim()));
+    Ok(model.unwrap_or("cpu").to_string())
+}
+
+/// The largest difference between `cfg`'s maps and the scalar CPU's over `frames`, relative
+/// to the CPU map's peak.
+fn max_rel_diff_vs_cpu(cfg: &SaliencyConfig, frames: &[RgbImage]) -> Result<f64> {
+    let (w, h) = frames[0].size();
+    let mut this = SaliencyEngine::new(cfg.clone(), w, h)?;
+    let mut reference = SaliencyEngine::new(SaliencyConfig { backend: Backend::Scalar, ..cfg.clone() }, w, h)?;
+    let mut worst = 0.0f64;
+    for f in frames {
+        let a = this.process(f)?.clone();
+        let b = reference.process(f)?;
+        let peak = b.as_slice().iter().fold(0.0f32, |m, v| m.max(v.abs())).max(1e-12);
+        let diff = a.as_slice().iter().zip(b.as_slice()).fold(0.0f32, |m, (x, y)| m.max((x - y).abs()));
+        worst = worst.max(f64::from(diff / peak));
+    }
+    Ok(worst)
+}
+
 /// Runs `ocellus bench saliency` with `backend`'s kernels, `n` frames per preset.
 pub fn run(a: &BenchArgs, backend: Backend, n: usize) -> Result<()> {
     let (width, height) = a.size();
     let frames = frames(a)?;
-    let presets = if a.preset.is_empty() {
+    let presets = if a.preset.is_empty() && backend == Backend::Gpu {
+        // The GPU front end does the ace2009 preset (opponency at each level).
+        vec!["ace2009".to_string()]
+    } else if a.preset.is_empty() {
         SaliencyConfig::PRESETS.iter().map(|s| s.to_string()).collect()
     } else {
         a.preset.clone()
@@ -124,10 +161,15 @@ pub fn run(a: &BenchArgs, backend: Backend, n: usize) -> Result<()> {
     out.insert("frame_height".into(), json!(height));
     out.insert("threads".into(), json!(rayon::current_num_threads()));
     out.insert("backend".into(), json!(backend.name()));
+    out.insert("device".into(), json!(device(backend)?));
     for p in &presets {
         let mut cfg = SaliencyConfig::preset(p)?;
         cfg.backend = backend;
-        out.insert(p.clone(), bench_preset(&cfg, &frames, n)?);
+        let mut figures = bench_preset(&cfg, &frames, n)?;
+        if backend == Backend::Gpu {
+            figures["max_rel_diff_vs_cpu"] = json!(max_rel_diff_vs_cpu(&cfg, &frames)?);
+        }
+        out.insert(p.clone(), figures);
     }
     out.insert("peak_rss_mb".into(), json!(peak_rss_mb()));
     let v = serde_json::Value::Object(out);
@@ -136,10 +178,11 @@ pub fn run(a: &BenchArgs, backend: Backend, n: usize) -> Result<()> {
         return Ok(());
     }
     outln!(
-        "saliency benchmark: {}x{}, backend {}, {} threads",
+        "saliency benchmark: {}x{}, backend {} on {}, {} threads",
         width,
         height,
         backend.name(),
+        v["device"].as_str().unwrap_or("?"),
         rayon::current_num_threads()
     );
     for p in &presets {
@@ -151,6 +194,9 @@ pub fn run(a: &BenchArgs, backend: Backend, n: usize) -> Result<()> {
             r["fps_all_threads"].as_f64().unwrap_or(0.0),
             r["speedup_all_threads"].as_f64().unwrap_or(0.0)
         );
+        if let Some(d) = r["max_rel_diff_vs_cpu"].as_f64() {
+            outln!("          largest difference from the scalar CPU map: {d:.2e} of its peak");
+        }
         if let Some(st) = r["stage_ms_1thread"].as_object() {
             for (k, ms) in st {
                 outln!("          {k:<20} {:.3} ms", ms.as_f64().unwrap_or(0.0));
