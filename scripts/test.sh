@@ -9,6 +9,8 @@ if [ -z "${VK_DRIVER_FILES:-}" ]; then
   lvp=$(ls /usr/share/vulkan/icd.d/lvp_icd*.json 2>/dev/null | head -n 1 || true)
   if [ -n "$lvp" ]; then export VK_DRIVER_FILES="$lvp"; fi
 fi
+# Mesa's device-select layer looks for a Wayland display and complains on headless machines.
+export NODEVICE_SELECT=1
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
 set +e
