@@ -122,7 +122,8 @@ impl GpuFrontEnd {
         }
         let top = sizes.len() - 1;
         let input_bytes = (3 * width * height).div_ceil(4) * 4;
-        let largest = 4 * (width * height).max(input_bytes / 4) as u64;
+        let gabor_planes = used.iter().map(|&l| n_angles * sizes[l].0 * sizes[l].1).max().unwrap_or(0);
+        let largest = 4 * (width * height).max(input_bytes / 4).max(gabor_planes) as u64;
         if largest > ctx.limits().max_storage_buffer_binding_size || largest > ctx.limits().max_buffer_size {
             return Err(GpuError::InvalidInput(format!(
                 "a {width}x{height} frame needs storage buffers of {largest} bytes; this device binds at most {}",
@@ -272,6 +273,13 @@ impl GpuFrontEnd {
                 copies.push((ori, n_angles as u64 * bytes, offset));
                 offset += n_angles as u64 * bytes;
             }
+        }
+        let most = ctx.limits().max_compute_workgroups_per_dimension;
+        if let Some(p) = passes.iter().find(|p| p.groups.iter().any(|&g| g > most)) {
+            return Err(GpuError::InvalidInput(format!(
+                "a {width}x{height} frame needs {:?} workgroups in one dispatch; this device allows {most} per dimension",
+                p.groups
+            )));
         }
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
