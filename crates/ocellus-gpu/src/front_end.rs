@@ -6,6 +6,7 @@ use crate::{GpuContext, GpuError, Result};
 use ocellus_image::pyramid::PyramidKernel;
 use ocellus_image::Plane;
 use std::sync::mpsc;
+use std::time::{Duration, Instant};
 use wgpu::util::DeviceExt;
 
 /// Angles the Gabor shader holds at once (its accumulator array).
@@ -73,6 +74,19 @@ pub struct GpuFrontEnd {
     copies: Vec<(wgpu::Buffer, u64, u64)>,
     staging: wgpu::Buffer,
     bytes: Vec<u8>,
+    timings: FrontEndTimings,
+}
+
+/// Wall time of one frame through the front end, by phase.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrontEndTimings {
+    /// Packing the frame's bytes and queueing their upload.
+    pub upload: Duration,
+    /// From submitting the dispatches until the results sit in the readback buffer (the
+    /// upload's transfer, every shader, and the copy to host-visible memory).
+    pub gpu: Duration,
+    /// Copying the mapped results into the planes.
+    pub readback: Duration,
 }
 
 impl std::fmt::Debug for GpuFrontEnd {
@@ -300,6 +314,7 @@ impl GpuFrontEnd {
             copies,
             staging,
             bytes: vec![0; input_bytes],
+            timings: FrontEndTimings::default(),
         })
     }
 
@@ -321,12 +336,14 @@ impl GpuFrontEnd {
                 self.height
             )));
         }
+        let t0 = Instant::now();
         let row_bytes = 3 * self.width;
         for (y, row) in frame.rows().enumerate() {
             self.bytes[y * row_bytes..(y + 1) * row_bytes].copy_from_slice(row.as_flattened());
         }
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);
         queue.write_buffer(&self.input, 0, &self.bytes);
+        let t1 = Instant::now();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("front end") });
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
@@ -347,6 +364,7 @@ impl GpuFrontEnd {
         });
         device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
         rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+        let t2 = Instant::now();
         {
             let view = self.staging.get_mapped_range(..).map_err(|e| GpuError::Readback(e.to_string()))?;
             let data: &[f32] = bytemuck::cast_slice(&view);
@@ -380,7 +398,13 @@ impl GpuFrontEnd {
             }
         }
         self.staging.unmap();
+        self.timings = FrontEndTimings { upload: t1 - t0, gpu: t2 - t1, readback: t2.elapsed() };
         Ok(())
+    }
+
+    /// Where the last frame's time went.
+    pub fn timings(&self) -> FrontEndTimings {
+        self.timings
     }
 
     /// The device this front end runs on.

@@ -17,7 +17,7 @@ mod context;
 mod front_end;
 
 pub use context::GpuContext;
-pub use front_end::{FrontEndSpec, GpuFrontEnd, MAX_ANGLES};
+pub use front_end::{FrontEndSpec, FrontEndTimings, GpuFrontEnd, MAX_ANGLES};
 
 /// Largest difference between a GPU and a CPU plane, relative to the CPU plane's largest
 /// magnitude, that the tests accept.

@@ -302,6 +302,13 @@ impl SaliencyEngine {
         self.backend
     }
 
+    /// The phases of the last frame's GPU front end (upload, GPU work, readback); `None` on
+    /// the CPU backends.
+    #[cfg(feature = "gpu")]
+    pub fn gpu_timings(&self) -> Option<ocellus_gpu::FrontEndTimings> {
+        self.gpu.as_ref().map(|g| g.timings())
+    }
+
     /// Whether the front end (pyramids, opponency, Gabor energies) runs on the GPU
     /// (`Backend::Gpu`); the map-level stages always run on the CPU.
     pub fn on_gpu(&self) -> bool {

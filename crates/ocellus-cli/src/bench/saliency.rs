@@ -37,12 +37,20 @@ fn bench_preset(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize) -> Result<s
     }
     let mut total = Vec::with_capacity(n);
     let mut stages: Vec<Vec<f64>> = (0..6).map(|_| Vec::with_capacity(n)).collect();
+    #[cfg_attr(not(feature = "gpu"), allow(unused_mut))]
+    let mut gpu_phases: [Vec<f64>; 3] = Default::default();
     for f in frames.iter().cycle().take(n) {
         let t = Instant::now();
         e.process(f)?;
         total.push(t.elapsed().as_secs_f64() * 1e3);
         for (k, (_, d)) in e.timings().stages().iter().enumerate() {
             stages[k].push(d.as_secs_f64() * 1e3);
+        }
+        #[cfg(feature = "gpu")]
+        if let Some(t) = e.gpu_timings() {
+            for (k, d) in [t.upload, t.gpu, t.readback].iter().enumerate() {
+                gpu_phases[k].push(d.as_secs_f64() * 1e3);
+            }
         }
     }
     let mean_ms = total.iter().sum::<f64>() / total.len() as f64;
@@ -65,7 +73,13 @@ fn bench_preset(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize) -> Result<s
         }
         (median(&mut one), median(&mut all))
     };
-    Ok(json!({
+    let mut phases = serde_json::Map::new();
+    if !gpu_phases[0].is_empty() {
+        for (name, v) in ["upload", "gpu", "readback"].iter().zip(gpu_phases.iter_mut()) {
+            phases.insert(name.to_string(), json!(median(v)));
+        }
+    }
+    let mut figures = json!({
         "ms_per_frame_1thread": ms,
         "ms_per_frame_1thread_mean": mean_ms,
         "fps_1thread": fps_1,
@@ -74,7 +88,11 @@ fn bench_preset(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize) -> Result<s
         "speedup_all_threads": fps_all / fps_1,
         "stage_ms_1thread": stage_ms,
         "frames_timed": n,
-    }))
+    });
+    if !phases.is_empty() {
+        figures["gpu_front_end_ms"] = serde_json::Value::Object(phases);
+    }
+    Ok(figures)
 }
 
 /// Frames per second of `threads` engines (one per thread, built and warmed up before the
@@ -194,6 +212,10 @@ pub fn run(a: &BenchArgs, backend: Backend, n: usize) -> Result<()> {
             r["fps_all_threads"].as_f64().unwrap_or(0.0),
             r["speedup_all_threads"].as_f64().unwrap_or(0.0)
         );
+        if let Some(ph) = r["gpu_front_end_ms"].as_object() {
+            let parts: Vec<String> = ph.iter().map(|(k, v)| format!("{k} {:.3}", v.as_f64().unwrap_or(0.0))).collect();
+            outln!("          GPU front end ms: {}", parts.join(", "));
+        }
         if let Some(d) = r["max_rel_diff_vs_cpu"].as_f64() {
             outln!("          largest difference from the scalar CPU map: {d:.2e} of its peak");
         }
