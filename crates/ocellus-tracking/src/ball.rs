@@ -144,7 +144,8 @@ impl BallModel {
     /// ([`BinnedFrame::update_region`]) gives the same scores as binning the frame. Empty
     /// when no state is in view.
     pub fn samples_region(&self, states: &[BallState], w: usize, h: usize) -> [usize; 4] {
-        states.par_iter().map(|s| self.circle(s).map_or([0; 4], |c| c.samples_rect(w, h))).reduce(|| [0; 4], union_rect)
+        let circles: Vec<Option<Circle>> = states.par_iter().map(|s| self.circle(s)).collect();
+        circles_region(&circles, w, h)
     }
 
     /// One step of a filter without detections (the plain SIR/SIS, `boost = 0`): moves the
@@ -162,9 +163,7 @@ impl BallModel {
         let (w, h) = frame.size();
         // Each circle is projected once, for the region and for the likelihood.
         let circles: Vec<Option<Circle>> = filter.particles().par_iter().map(|s| self.circle(s)).collect();
-        let region =
-            circles.par_iter().map(|c| c.map_or([0; 4], |c| c.samples_rect(w, h))).reduce(|| [0; 4], union_rect);
-        obs.binned.update_region(frame, region);
+        obs.binned.update_region(frame, circles_region(&circles, w, h));
         self.weigh_circles(filter, obs, &circles)
     }
 
@@ -200,6 +199,12 @@ impl BallModel {
             }
         })?)
     }
+}
+
+/// The rectangle holding every sample of every circle in a `w` x `h` frame (`None`: out of
+/// view); empty when none is in view.
+fn circles_region(circles: &[Option<Circle>], w: usize, h: usize) -> [usize; 4] {
+    circles.par_iter().map(|c| c.map_or([0; 4], |c| c.samples_rect(w, h))).reduce(|| [0; 4], union_rect)
 }
 
 impl Model for BallModel {

@@ -110,13 +110,13 @@ impl BenchArgs {
 /// Runs the subcommand.
 pub fn run(a: BenchArgs) -> Result<()> {
     a.reject_unused()?;
-    let n = a.frames.unwrap_or(if a.backend.as_deref() == Some("gpu") { 50 } else { 300 });
     let backend_name = a.backend.as_deref().unwrap_or("auto");
     let backend: Backend = serde_json::from_value(json!(backend_name))
         .map_err(|_| anyhow::anyhow!("unknown backend '{backend_name}' (auto, scalar, sse41, avx2, avx512, gpu)"))?;
     if backend == Backend::Gpu && !matches!(a.target, Target::Saliency) {
         bail!("--backend gpu is for bench saliency only (the other pipelines have no GPU path)");
     }
+    let n = a.frames.unwrap_or(if backend == Backend::Gpu { 50 } else { 300 });
     match a.target {
         Target::Attention => return attention::run(a.json, n),
         Target::Planning => return planning::run(a.json, backend, n.max(100)),
