@@ -105,6 +105,12 @@ impl Normalizer {
         })
     }
 
+    /// The 1D excitatory and inhibitory kernels of the iterative rule (peaks `c / (sigma
+    /// sqrt(2 pi))`, cut and capped as [`gaussian_kernel`]); `None` for the other rules.
+    pub fn kernels(&self) -> Option<[&[f32]; 2]> {
+        Some([self.excitation.as_ref()?.kernel(), self.inhibition.as_ref()?.kernel()])
+    }
+
     /// Applies N(.) in place: clamp at 0, scale to `[0, range]` when `range` is given, then
     /// compete. The result is finite and non-negative for any finite input.
     pub fn apply(&mut self, backend: Backend, map: &mut Plane<f32>, range: Option<f32>) -> Result<()> {

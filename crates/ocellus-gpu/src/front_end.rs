@@ -1,13 +1,17 @@
-//! The per-pixel front end of the saliency pipeline on the GPU: the colour pyramids, the
-//! opponency planes and the Gabor energies of the levels the center-surround pairs read, in
-//! one command buffer per frame, read back in one copy.
+//! The saliency pipeline on the GPU: the per-pixel front end (the colour pyramids, the
+//! opponency planes and the Gabor energies of the levels the center-surround pairs read) and,
+//! when built with them, the map-level stages (`back_end`), in one command buffer per frame;
+//! what is asked is read back through one host-visible buffer.
 
+use crate::back_end::{BackEnd, BackEndSpec, LevelOffsets};
 use crate::{GpuContext, GpuError, Result};
 use ocellus_image::pyramid::PyramidKernel;
 use ocellus_image::Plane;
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 use wgpu::util::DeviceExt;
+
+mod batch;
 
 /// Angles the Gabor shader holds at once (its accumulator array).
 pub const MAX_ANGLES: usize = 8;
@@ -31,10 +35,10 @@ enum Program {
 }
 
 /// One dispatch: its program, bindings and workgroup counts.
-struct Pass {
-    program: Program,
-    bind_group: wgpu::BindGroup,
-    groups: [u32; 3],
+pub(crate) struct Pass {
+    pub(crate) pipeline: wgpu::ComputePipeline,
+    pub(crate) bind_group: wgpu::BindGroup,
+    pub(crate) groups: [u32; 3],
 }
 
 /// What the front end computes, in plain terms; the saliency engine (`ocellus-attention`,
@@ -57,9 +61,13 @@ pub struct FrontEndSpec {
     pub gabor: Vec<[Vec<f32>; 2]>,
     /// Side of the Gabor kernels, pixels (odd).
     pub gabor_size: usize,
+    /// The map-level stages (rescaling, center-surround, N(.), combination) to run on the
+    /// device after the front end ([`GpuFrontEnd::process_maps`]); `None`: front end only.
+    pub back_end: Option<BackEndSpec>,
 }
 
-/// The GPU front end for frames of one size.
+/// The GPU saliency pipeline for frames of one size: the front end, and the map-level
+/// stages when its spec has them.
 pub struct GpuFrontEnd {
     ctx: GpuContext,
     width: usize,
@@ -67,15 +75,34 @@ pub struct GpuFrontEnd {
     sizes: Vec<(usize, usize)>,
     used: Vec<usize>,
     n_angles: usize,
-    pipelines: Vec<wgpu::ComputePipeline>,
     passes: Vec<Pass>,
     input: wgpu::Buffer,
-    /// Source buffer, bytes, offset in `staging`.
-    copies: Vec<(wgpu::Buffer, u64, u64)>,
+    /// The used levels' opponency planes (see `offsets`).
+    planes: wgpu::Buffer,
+    /// The used levels' Gabor energies.
+    energies: wgpu::Buffer,
+    /// Offsets (floats) of each used level's planes in `planes` then `energies`, one after
+    /// the other.
+    offsets: Vec<LevelOffsets>,
+    /// Bytes of `planes`, and of both.
+    opp_bytes: u64,
+    planes_bytes: u64,
+    /// The map-level stages, when built.
+    back: Option<BackEnd>,
+    maps_bytes: u64,
+    /// Host-visible copy of the maps (first) and the levels (after them).
     staging: wgpu::Buffer,
     bytes: Vec<u8>,
     timings: FrontEndTimings,
+    /// What a batch needs to unpack each of its frames.
+    unpack: batch::Unpack,
+    /// The buffers of the largest batch run so far.
+    batch: Option<batch::Batch>,
 }
+
+/// Where the used levels' planes are read back to: the opponency pyramids (intensity,
+/// red-green, blue-yellow; indexed by level) and the Gabor energies (by level, then angle).
+pub type LevelsOut<'a> = (&'a mut [Vec<Plane<f32>>; 3], &'a mut Vec<Vec<Plane<f32>>>);
 
 /// Wall time of one frame through the front end, by phase.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -175,14 +202,22 @@ impl GpuFrontEnd {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
         let uniform = |words: [u32; 8]| init("dims", bytemuck::cast_slice(&words), wgpu::BufferUsages::UNIFORM);
-        let bind = |program: Program, buffers: &[&wgpu::Buffer]| {
+        let bind_parts = |program: Program, resources: Vec<wgpu::BindingResource>| {
             let layout = pipelines[program as usize].get_bind_group_layout(0);
-            let entries: Vec<wgpu::BindGroupEntry> = buffers
-                .iter()
+            let entries: Vec<wgpu::BindGroupEntry> = resources
+                .into_iter()
                 .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+                .map(|(i, resource)| wgpu::BindGroupEntry { binding: i as u32, resource })
                 .collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &layout, entries: &entries })
+        };
+        let bind = |program: Program, buffers: &[&wgpu::Buffer]| {
+            bind_parts(program, buffers.iter().map(|b| b.as_entire_binding()).collect())
+        };
+        let pass = |program: Program, bind_group: wgpu::BindGroup, groups: [u32; 3]| Pass {
+            pipeline: pipelines[program as usize].clone(),
+            bind_group,
+            groups,
         };
 
         let input = device.create_buffer(&wgpu::BufferDescriptor {
@@ -199,11 +234,18 @@ impl GpuFrontEnd {
         let n = width * height;
         let blocks = n.div_ceil(256);
         let unpack_dims = uniform([n as u32, 0, 0, 0, 0, 0, 0, 0]);
-        passes.push(Pass {
-            program: Program::Unpack,
-            bind_group: bind(Program::Unpack, &[&unpack_dims, &input, &rgb[0][0], &rgb[1][0], &rgb[2][0]]),
-            groups: [blocks.min(65535) as u32, blocks.div_ceil(65535) as u32, 1],
-        });
+        let unpack_groups = [blocks.min(65535) as u32, blocks.div_ceil(65535) as u32, 1];
+        passes.push(pass(
+            Program::Unpack,
+            bind(Program::Unpack, &[&unpack_dims, &input, &rgb[0][0], &rgb[1][0], &rgb[2][0]]),
+            unpack_groups,
+        ));
+        let unpack = batch::Unpack {
+            pipeline: pipelines[Program::Unpack as usize].clone(),
+            dims: unpack_dims.clone(),
+            level0: [rgb[0][0].clone(), rgb[1][0].clone(), rgb[2][0].clone()],
+            groups: unpack_groups,
+        };
 
         // Tap tables from the CPU's own rule (PyramidKernel::taps_for), padded with zero
         // weights to the kernel's length.
@@ -227,16 +269,16 @@ impl GpuFrontEnd {
             let vd = uniform([wi as u32, hi as u32, wi as u32, ho as u32, k as u32, 0, 0, 0]);
             let hd = uniform([wi as u32, ho as u32, wo as u32, ho as u32, k as u32, 0, 0, 0]);
             for c in 0..3 {
-                passes.push(Pass {
-                    program: Program::PyrVertical,
-                    bind_group: bind(Program::PyrVertical, &[&vd, &rgb[c][l], &vt, &tmp]),
-                    groups: [groups(wi, 64), groups(ho, 4), 1],
-                });
-                passes.push(Pass {
-                    program: Program::PyrHorizontal,
-                    bind_group: bind(Program::PyrHorizontal, &[&hd, &tmp, &ht, &rgb[c][l + 1]]),
-                    groups: [groups(wo, 64), groups(ho, 4), 1],
-                });
+                passes.push(pass(
+                    Program::PyrVertical,
+                    bind(Program::PyrVertical, &[&vd, &rgb[c][l], &vt, &tmp]),
+                    [groups(wi, 64), groups(ho, 4), 1],
+                ));
+                passes.push(pass(
+                    Program::PyrHorizontal,
+                    bind(Program::PyrHorizontal, &[&hd, &tmp, &ht, &rgb[c][l + 1]]),
+                    [groups(wo, 64), groups(ho, 4), 1],
+                ));
             }
         }
 
@@ -248,11 +290,45 @@ impl GpuFrontEnd {
             vec![0.0; 2]
         };
         let kernels = init("gabor kernels", bytemuck::cast_slice(&kernels), wgpu::BufferUsages::STORAGE);
-        let mut copies = Vec::new();
-        let mut offset = 0u64;
+        // Every used level's opponency planes in one buffer, and their Gabor energies in
+        // another (a dispatch may not read and write one buffer), each plane at an offset
+        // the device can bind: the map-level stages read them all through two bindings, and
+        // two copies read them back. Offsets count floats in the two buffers one after the
+        // other.
+        let align = (ctx.limits().min_storage_buffer_offset_alignment as usize / 4).max(1);
+        let up = |v: usize| v.div_ceil(align) * align;
+        let mut offsets: Vec<LevelOffsets> = Vec::with_capacity(used.len());
+        let mut end = 0usize;
         for &l in &used {
+            let n = sizes[l].0 * sizes[l].1;
+            let o = [end, up(end + n), up(up(end + n) + n)].map(|v| v as u64);
+            end = up(o[2] as usize + n);
+            offsets.push([o[0], o[1], o[2], 0]);
+        }
+        let opp_floats = end;
+        for (li, &l) in used.iter().enumerate() {
+            offsets[li][3] = end as u64;
+            end = up(end + n_angles * sizes[l].0 * sizes[l].1);
+        }
+        let most = ctx.limits().max_storage_buffer_binding_size.min(ctx.limits().max_buffer_size);
+        if 4 * opp_floats.max(end - opp_floats) as u64 > most {
+            return Err(GpuError::InvalidInput(format!(
+                "a {width}x{height} frame's levels need {} bytes in one buffer; this device binds at most {most}",
+                4 * opp_floats.max(end - opp_floats),
+            )));
+        }
+        let planes = storage(opp_floats, "levels");
+        let energies = storage(end - opp_floats, "gabor energies");
+        let part = |buffer, at: u64, floats: usize| {
+            wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer,
+                offset: 4 * at,
+                size: std::num::NonZeroU64::new(4 * floats.max(1) as u64),
+            })
+        };
+        for (li, &l) in used.iter().enumerate() {
             let (w, h) = sizes[l];
-            let opp: Vec<wgpu::Buffer> = ["intensity", "red-green", "blue-yellow"].map(|s| storage(w * h, s)).into();
+            let o = offsets[li];
             let dims = uniform([
                 (w * h) as u32,
                 0,
@@ -263,31 +339,41 @@ impl GpuFrontEnd {
                 weights[2].to_bits(),
                 threshold.to_bits(),
             ]);
-            passes.push(Pass {
-                program: Program::Opponency,
-                bind_group: bind(
-                    Program::Opponency,
-                    &[&dims, &rgb[0][l], &rgb[1][l], &rgb[2][l], &opp[0], &opp[1], &opp[2]],
-                ),
-                groups: [groups(w * h, 256), 1, 1],
-            });
-            let bytes = 4 * (w * h) as u64;
-            for b in &opp {
-                copies.push((b.clone(), bytes, offset));
-                offset += bytes;
-            }
+            let resources = vec![
+                dims.as_entire_binding(),
+                rgb[0][l].as_entire_binding(),
+                rgb[1][l].as_entire_binding(),
+                rgb[2][l].as_entire_binding(),
+                part(&planes, o[0], w * h),
+                part(&planes, o[1], w * h),
+                part(&planes, o[2], w * h),
+            ];
+            passes.push(pass(
+                Program::Opponency,
+                bind_parts(Program::Opponency, resources),
+                [groups(w * h, 256), 1, 1],
+            ));
             if with_ori {
-                let ori = storage(n_angles * w * h, "gabor energy");
                 let dims = uniform([w as u32, h as u32, spec.gabor_size as u32, n_angles as u32, 0, 0, 0, 0]);
-                passes.push(Pass {
-                    program: Program::Gabor,
-                    bind_group: bind(Program::Gabor, &[&dims, &opp[0], &kernels, &ori]),
-                    groups: [groups(w, 16), groups(h, 16), 1],
-                });
-                copies.push((ori, n_angles as u64 * bytes, offset));
-                offset += n_angles as u64 * bytes;
+                let resources = vec![
+                    dims.as_entire_binding(),
+                    part(&planes, o[0], w * h),
+                    kernels.as_entire_binding(),
+                    part(&energies, o[3] - opp_floats as u64, n_angles * w * h),
+                ];
+                passes.push(pass(
+                    Program::Gabor,
+                    bind_parts(Program::Gabor, resources),
+                    [groups(w, 16), groups(h, 16), 1],
+                ));
             }
         }
+        let back = match &spec.back_end {
+            Some(b) => Some(BackEnd::new(ctx, b, &sizes, &used, &offsets, n_angles, [&planes, &energies], opp_floats)?),
+            None => None,
+        };
+        let (opp_bytes, planes_bytes) = (4 * opp_floats as u64, 4 * end as u64);
+        let maps_bytes = back.as_ref().map_or(0, |b| 4 * (b.n_maps * b.map_size.0 * b.map_size.1) as u64);
         let most = ctx.limits().max_compute_workgroups_per_dimension;
         if let Some(p) = passes.iter().find(|p| p.groups.iter().any(|&g| g > most)) {
             return Err(GpuError::InvalidInput(format!(
@@ -295,9 +381,11 @@ impl GpuFrontEnd {
                 p.groups
             )));
         }
+        // The maps first, then the levels: a frame that reads back only the maps maps the
+        // start of the buffer.
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
-            size: offset.max(4),
+            size: (maps_bytes + planes_bytes).max(4),
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -308,24 +396,65 @@ impl GpuFrontEnd {
             sizes,
             used,
             n_angles,
-            pipelines,
             passes,
             input,
-            copies,
+            planes,
+            energies,
+            offsets,
+            opp_bytes,
+            planes_bytes,
+            back,
+            maps_bytes,
             staging,
             bytes: vec![0; input_bytes],
             timings: FrontEndTimings::default(),
+            unpack,
+            batch: None,
         })
     }
 
     /// Runs the front end on an 8-bit RGB frame: `opponency[k][l]` (k: intensity, red-green,
     /// blue-yellow) and `orientation[l][a]` receive level `l`'s planes for every used level;
     /// the outer vectors grow to the pyramid's height, other levels are left as they are.
+    /// The map-level stages, if built, do not run.
     pub fn process(
         &mut self,
         frame: &Plane<[u8; 3]>,
         opponency: &mut [Vec<Plane<f32>>; 3],
         orientation: &mut Vec<Vec<Plane<f32>>>,
+    ) -> Result<()> {
+        self.run(frame, None, Some((opponency, orientation)))
+    }
+
+    /// Runs the whole pipeline (built with [`FrontEndSpec::back_end`]) on an 8-bit RGB frame
+    /// and reads back its maps into `maps`, in order: the feature maps, the sub-feature
+    /// maps, the conspicuity maps and the saliency map (each resized to the map size);
+    /// `levels`, when given, receives the used levels' planes as [`Self::process`] does.
+    pub fn process_maps<'a>(
+        &mut self,
+        frame: &Plane<[u8; 3]>,
+        maps: impl IntoIterator<Item = &'a mut Plane<f32>>,
+        levels: Option<LevelsOut>,
+    ) -> Result<()> {
+        if self.back.is_none() {
+            return Err(GpuError::InvalidInput("this GPU engine was built without the map-level stages".into()));
+        }
+        let mut maps = maps.into_iter();
+        self.run(frame, Some(&mut maps), levels)
+    }
+
+    /// Number of maps [`Self::process_maps`] writes (0 without the map-level stages).
+    pub fn map_count(&self) -> usize {
+        self.back.as_ref().map_or(0, |b| b.n_maps)
+    }
+
+    /// Uploads `frame`, runs the front end (and the back end when `maps` is given), and reads
+    /// back what is asked.
+    fn run(
+        &mut self,
+        frame: &Plane<[u8; 3]>,
+        maps: Option<&mut dyn Iterator<Item = &mut Plane<f32>>>,
+        levels: Option<LevelsOut>,
     ) -> Result<()> {
         if frame.size() != (self.width, self.height) {
             return Err(GpuError::InvalidInput(format!(
@@ -344,62 +473,89 @@ impl GpuFrontEnd {
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);
         queue.write_buffer(&self.input, 0, &self.bytes);
         let t1 = Instant::now();
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("front end") });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("saliency") });
+        let back = match (&self.back, maps.is_some()) {
+            (Some(b), true) => Some(b),
+            _ => None,
+        };
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
-            for p in &self.passes {
-                pass.set_pipeline(&self.pipelines[p.program as usize]);
+            for p in self.passes.iter().chain(back.into_iter().flat_map(|b| &b.passes)) {
+                pass.set_pipeline(&p.pipeline);
                 pass.set_bind_group(0, &p.bind_group, &[]);
                 pass.dispatch_workgroups(p.groups[0], p.groups[1], p.groups[2]);
             }
         }
-        for (src, bytes, offset) in &self.copies {
-            encoder.copy_buffer_to_buffer(src, 0, &self.staging, *offset, *bytes);
+        if let Some(b) = back {
+            encoder.copy_buffer_to_buffer(&b.maps, 0, &self.staging, 0, self.maps_bytes);
         }
+        if levels.is_some() {
+            let at = self.maps_bytes;
+            encoder.copy_buffer_to_buffer(&self.planes, 0, &self.staging, at, self.opp_bytes);
+            if self.planes_bytes > self.opp_bytes {
+                let rest = self.planes_bytes - self.opp_bytes;
+                encoder.copy_buffer_to_buffer(&self.energies, 0, &self.staging, at + self.opp_bytes, rest);
+            }
+        }
+        let end = if levels.is_some() { self.maps_bytes + self.planes_bytes } else { self.maps_bytes };
         queue.submit([encoder.finish()]);
-        let (tx, rx) = mpsc::channel();
-        self.staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            // The receiver waits below; a send can only fail if it is gone.
-            let _ = tx.send(r);
-        });
-        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
-        rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
-        let t2 = Instant::now();
-        {
-            let view = self.staging.get_mapped_range(..).map_err(|e| GpuError::Readback(e.to_string()))?;
-            let data: &[f32] = bytemuck::cast_slice(&view);
-            let n_levels = self.sizes.len();
-            for p in opponency.iter_mut() {
-                if p.len() < n_levels {
-                    p.resize_with(n_levels, Plane::default);
+        let t2;
+        if end > 0 {
+            let (tx, rx) = mpsc::channel();
+            self.staging.slice(..end).map_async(wgpu::MapMode::Read, move |r| {
+                // The receiver waits below; a send can only fail if it is gone.
+                let _ = tx.send(r);
+            });
+            device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
+            rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+            t2 = Instant::now();
+            {
+                let view = self.staging.get_mapped_range(..end).map_err(|e| GpuError::Readback(e.to_string()))?;
+                let data: &[f32] = bytemuck::cast_slice(&view);
+                if let (Some(b), Some(maps)) = (&self.back, maps) {
+                    let (w, h) = b.map_size;
+                    for (k, dst) in maps.take(b.n_maps).enumerate() {
+                        copy_plane(&data[k * w * h..(k + 1) * w * h], w, h, dst);
+                    }
+                }
+                if let Some((opponency, orientation)) = levels {
+                    let data = &data[(self.maps_bytes / 4) as usize..];
+                    self.read_levels(data, opponency, orientation);
                 }
             }
-            if orientation.len() < n_levels {
-                orientation.resize_with(n_levels, Vec::new);
-            }
-            let mut at = 0usize;
-            let mut take = |dst: &mut Plane<f32>, (w, h): (usize, usize)| {
-                dst.resize(w, h);
-                for (y, row) in data[at..at + w * h].chunks_exact(w.max(1)).enumerate() {
-                    dst.row_mut(y).copy_from_slice(row);
-                }
-                at += w * h;
-            };
-            for &l in &self.used {
-                let size = self.sizes[l];
-                for k in 0..3 {
-                    take(&mut opponency[k][l], size);
-                }
-                let ori = &mut orientation[l];
-                ori.resize_with(self.n_angles, Plane::default);
-                for plane in ori.iter_mut() {
-                    take(plane, size);
-                }
-            }
+            self.staging.unmap();
+        } else {
+            device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
+            t2 = Instant::now();
         }
-        self.staging.unmap();
         self.timings = FrontEndTimings { upload: t1 - t0, gpu: t2 - t1, readback: t2.elapsed() };
         Ok(())
+    }
+
+    /// Copies the used levels' planes out of `data` (the level buffer's contents).
+    fn read_levels(&self, data: &[f32], opponency: &mut [Vec<Plane<f32>>; 3], orientation: &mut Vec<Vec<Plane<f32>>>) {
+        let n_levels = self.sizes.len();
+        for p in opponency.iter_mut() {
+            if p.len() < n_levels {
+                p.resize_with(n_levels, Plane::default);
+            }
+        }
+        if orientation.len() < n_levels {
+            orientation.resize_with(n_levels, Vec::new);
+        }
+        for (li, &l) in self.used.iter().enumerate() {
+            let (w, h) = self.sizes[l];
+            let o = self.offsets[li].map(|v| v as usize);
+            for k in 0..3 {
+                copy_plane(&data[o[k]..o[k] + w * h], w, h, &mut opponency[k][l]);
+            }
+            let ori = &mut orientation[l];
+            ori.resize_with(self.n_angles, Plane::default);
+            for (a, plane) in ori.iter_mut().enumerate() {
+                let at = o[3] + a * w * h;
+                copy_plane(&data[at..at + w * h], w, h, plane);
+            }
+        }
     }
 
     /// Where the last frame's time went.
@@ -410,5 +566,13 @@ impl GpuFrontEnd {
     /// The device this front end runs on.
     pub fn context(&self) -> &GpuContext {
         &self.ctx
+    }
+}
+
+/// `dst` (resized to `w` x `h`) from `src`, row-major.
+fn copy_plane(src: &[f32], w: usize, h: usize, dst: &mut Plane<f32>) {
+    dst.resize(w, h);
+    for (y, row) in src.chunks_exact(w.max(1)).take(h).enumerate() {
+        dst.row_mut(y).copy_from_slice(row);
     }
 }

@@ -75,6 +75,11 @@ impl PreservingFilter {
         })
     }
 
+    /// The 1D kernel (the same on both axes).
+    pub fn kernel(&self) -> &[f32] {
+        &self.k
+    }
+
     /// Filters `src` (which must be `width` x `height`) into `dst`.
     pub fn apply(&mut self, backend: Backend, src: &Plane<f32>, dst: &mut Plane<f32>) -> Result<()> {
         crate::check::same_size("map", src.size(), (self.width, self.height))?;

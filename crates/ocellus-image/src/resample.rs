@@ -76,6 +76,14 @@ impl Resampler {
         self.dst
     }
 
+    /// The per-axis tables, x then y: for each destination index, the two source indices
+    /// (i0, i1) and the weight of i1; a destination pixel is the lerp by the y weight of rows
+    /// i0 and i1 (row i0 alone when the weight is 0), then by the x weight of those columns
+    /// (what a GPU shader needs to give the same values).
+    pub fn tables(&self) -> [&[(usize, usize, f32)]; 2] {
+        [&self.xs, &self.ys]
+    }
+
     /// Resamples `src` into `dst` (resized to the destination size); `row` is scratch space
     /// (one source row), kept by the caller so that steady state allocates nothing;
     /// `backend` chooses the kernel's build.

@@ -90,9 +90,51 @@ fn bench_preset(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize) -> Result<s
         "frames_timed": n,
     });
     if !phases.is_empty() {
-        figures["gpu_front_end_ms"] = serde_json::Value::Object(phases);
+        figures["gpu_phase_ms"] = serde_json::Value::Object(phases);
+    }
+    if cfg.backend == Backend::Gpu {
+        // The whole frame is one GPU round trip: its phases replace the CPU's stages.
+        if let Some(m) = figures.as_object_mut() {
+            m.remove("stage_ms_1thread");
+        }
+        gpu_figures(cfg, frames, n, &mut figures)?;
     }
     Ok(figures)
+}
+
+/// The GPU's end-to-end milliseconds per frame (upload, the whole pipeline, readback) with
+/// only the map-level outputs read back (no pyramid levels), and in batches of 8 and 64
+/// frames (one submission, only the saliency maps read back); medians over `n` frames.
+fn gpu_figures(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize, figures: &mut serde_json::Value) -> Result<()> {
+    let (w, h) = frames[0].size();
+    let mut e = SaliencyEngine::new(cfg.clone(), w, h)?;
+    e.set_gpu_level_readback(false);
+    for f in frames.iter().take(3) {
+        e.process(f)?;
+    }
+    let mut t: Vec<f64> = frames
+        .iter()
+        .cycle()
+        .take(n)
+        .map(|f| {
+            let s = Instant::now();
+            e.process(f).map(|_| s.elapsed().as_secs_f64() * 1e3)
+        })
+        .collect::<std::result::Result<_, _>>()?;
+    figures["ms_per_frame_maps_only"] = json!(median(&mut t));
+    let mut out = Vec::new();
+    for batch in [8usize, 64] {
+        let group: Vec<RgbImage> = frames.iter().cycle().take(batch).cloned().collect();
+        e.process_batch(&group, &mut out)?;
+        let mut per_frame: Vec<f64> = (0..(n / batch).max(1))
+            .map(|_| {
+                let s = Instant::now();
+                e.process_batch(&group, &mut out).map(|_| s.elapsed().as_secs_f64() * 1e3 / batch as f64)
+            })
+            .collect::<std::result::Result<_, _>>()?;
+        figures[format!("ms_per_frame_batch_{batch}")] = json!(median(&mut per_frame));
+    }
+    Ok(())
 }
 
 /// Frames per second of `threads` engines (one per thread, built and warmed up before the
@@ -212,9 +254,12 @@ pub fn run(a: &BenchArgs, backend: Backend, n: usize) -> Result<()> {
             r["fps_all_threads"].as_f64().unwrap_or(0.0),
             r["speedup_all_threads"].as_f64().unwrap_or(0.0)
         );
-        if let Some(ph) = r["gpu_front_end_ms"].as_object() {
+        if let Some(ph) = r["gpu_phase_ms"].as_object() {
             let parts: Vec<String> = ph.iter().map(|(k, v)| format!("{k} {:.3}", v.as_f64().unwrap_or(0.0))).collect();
-            outln!("          GPU front end ms: {}", parts.join(", "));
+            outln!("          GPU phases ms: {}", parts.join(", "));
+            for key in ["ms_per_frame_maps_only", "ms_per_frame_batch_8", "ms_per_frame_batch_64"] {
+                outln!("          {key:<24} {:.3}", r[key].as_f64().unwrap_or(0.0));
+            }
         }
         if let Some(d) = r["max_rel_diff_vs_cpu"].as_f64() {
             outln!("          largest difference from the scalar CPU map: {d:.2e} of its peak");
