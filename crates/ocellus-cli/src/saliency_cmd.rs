@@ -36,9 +36,10 @@ pub struct SaliencyArgs {
     /// and the order of the printed lines do not depend on it. Range: 0..=256.
     #[arg(long, default_value_t = 0, value_parser = crate::ranges::within(0usize, 256))]
     pub workers: usize,
-    /// Run the per-pixel front end (pyramids, opponency, Gabor energies) on the GPU through
-    /// wgpu (Vulkan, Metal or DX12; a software Vulkan driver works too, slowly), the
-    /// map-level stages on the CPU: `backend = "gpu"` of the configuration. The maps equal
+    /// Run the whole pipeline (pyramids, opponency, Gabor energies, then rescaling,
+    /// center-surround, N(.) and combination) on the GPU through wgpu (Vulkan, Metal or DX12;
+    /// a software Vulkan driver works too, slowly): `backend = "gpu"` of the configuration;
+    /// only a spatial prior is applied on the CPU. The maps equal
     /// the CPU's within 1e-4 of their peak. It needs opponency at each level (the ace2009
     /// preset) and the intensity, colour and orientation channels only; 16-bit inputs are
     /// reduced to 8 bits.

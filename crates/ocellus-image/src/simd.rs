@@ -33,10 +33,10 @@ pub enum Backend {
     /// AVX-512 F + BW + VL + DQ (x86-64), which implies AVX2 + FMA: every float kernel
     /// compiled for 512-bit registers; the hand-written integer kernels run their AVX2 form.
     Avx512,
-    /// The GPU, through wgpu, where a pipeline has a GPU path: the saliency engine's per-pixel
-    /// front end, with the `gpu` feature of `ocellus-attention`. Everything that runs on the
-    /// CPU meanwhile (the saliency map's level-4 stages, every other pipeline) uses the best
-    /// CPU backend, as `Auto`.
+    /// The GPU, through wgpu, where a pipeline has a GPU path: the saliency engine's whole
+    /// pipeline, with the `gpu` feature of `ocellus-attention`. Everything that runs on the
+    /// CPU meanwhile (a spatial prior, every other pipeline) uses the best CPU backend, as
+    /// `Auto`.
     Gpu,
 }
 

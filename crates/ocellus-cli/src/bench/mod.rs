@@ -68,7 +68,7 @@ pub struct BenchArgs {
     #[arg(long, value_delimiter = ',')]
     pub preset: Vec<String>,
     /// Kernel build: auto, scalar, sse41, avx2 or avx512 (an unavailable one falls back to the best
-    /// below it), or gpu (saliency only: the front end on the GPU, the ace2009 preset by
+    /// below it), or gpu (saliency only: the whole pipeline on the GPU, the ace2009 preset by
     /// default) [default: auto]. Not for attention (it times the `attend` command).
     #[arg(long)]
     pub backend: Option<String>,
