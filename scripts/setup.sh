@@ -2,7 +2,8 @@
 # Installs the system packages ocellus needs on a fresh Debian machine.
 # The build needs a Rust toolchain and a C compiler; video input (ocellus attend/surprise and
 # their tests) runs the ffmpeg program as a subprocess; the GPU backend needs a Vulkan loader
-# and, without a GPU, a software Vulkan driver.
+# and, without a GPU, a software Vulkan driver; the Python package's tests need python3 with
+# venv.
 set -euo pipefail
 
 need=()
@@ -13,6 +14,9 @@ command -v ffmpeg >/dev/null 2>&1 || need+=(ffmpeg)
 # (lavapipe) where there is no GPU.
 ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1 || need+=(mesa-vulkan-drivers)
 ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1' || need+=(libvulkan1)
+# The Python package's tests run in a virtual environment (python3 -m venv, with pip).
+command -v python3 >/dev/null 2>&1 || need+=(python3)
+python3 -m venv --help >/dev/null 2>&1 || need+=(python3-venv)
 
 if [ ${#need[@]} -gt 0 ]; then
   if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi

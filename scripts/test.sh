@@ -45,6 +45,24 @@ for e in "${examples[@]}"; do
   fi
 done
 rm -f "$log.example"
+# The Python package (python/): a virtual environment filled from the package registry, the
+# wheel built by maturin and installed (`pip install ./python`), then pytest. The tests compare
+# with the command-line program the cargo tests built.
+py_passed=0
+if [ "$status" -eq 0 ]; then
+  venv=target/python-venv
+  [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+  "$venv/bin/pip" install -q --disable-pip-version-check numpy pytest
+  if "$venv/bin/pip" install -q --disable-pip-version-check ./python \
+    && OCELLUS_BIN="$PWD/target/debug/ocellus" "$venv/bin/python" -m pytest -q python/tests > "$log.py" 2>&1; then
+    py_passed=$(grep -Eo '[0-9]+ passed' "$log.py" | grep -Eo '[0-9]+' || echo 0)
+  else
+    cat "$log.py" 2>/dev/null || true
+    echo "the Python package's tests failed"
+    status=1
+  fi
+  rm -f "$log.py"
+fi
 # One closing line for the whole suite (cargo prints one per test binary).
-awk -v ran="$ran" -v all="${#examples[@]}" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed; examples: %d of %d ran\n", p, f, ran, all }' "$log"
+awk -v ran="$ran" -v all="${#examples[@]}" -v py="$py_passed" '/^test result:/ { p += $4; f += $6 } END { printf "tests: %d passed, %d failed; examples: %d of %d ran; python: %d passed\n", p, f, ran, all, py }' "$log"
 exit "$status"

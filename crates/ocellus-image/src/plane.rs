@@ -147,6 +147,16 @@ impl<T: Copy + Default> Plane<T> {
         (self.stride == self.width).then(|| &mut self.data[..n])
     }
 
+    /// The pixels as a contiguous vector (row-major): the plane's own buffer when its rows
+    /// are contiguous (no copy), else a compacted copy.
+    pub fn into_vec(mut self) -> Vec<T> {
+        if self.stride == self.width {
+            self.data.truncate(self.width * self.height);
+            return self.data;
+        }
+        self.to_vec()
+    }
+
     /// Copies the pixels into a new contiguous vector (row-major).
     pub fn to_vec(&self) -> Vec<T> {
         self.rows().flat_map(|r| r.iter().copied()).collect()

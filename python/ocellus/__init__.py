@@ -1,0 +1,47 @@
+"""ocellus: fast, biologically inspired active vision (the Rust library, from Python).
+
+Arrays are numpy, row-major, indexed ``[y, x]``; images are ``uint8`` (0..255) or ``float32``
+(0..1), H x W (grey) or H x W x 3 (RGB); pixel centres sit at integer coordinates. Maps come
+back as ``float32`` arrays that own the library's buffers. Heavy calls release the GIL.
+Errors raise :class:`OcellusError` (a ``ValueError``) with the library's message.
+"""
+
+from ._ocellus import (
+    LogPolar,
+    OcellusError,
+    SaliencyEngine,
+    auc_borji,
+    auc_judd,
+    cc,
+    ig,
+    kl,
+    logpolar,
+    nss,
+    presets,
+    read_image,
+    register,
+    saliency,
+    sauc,
+    sim,
+    vergence,
+)
+
+__all__ = [
+    "LogPolar",
+    "OcellusError",
+    "SaliencyEngine",
+    "auc_borji",
+    "auc_judd",
+    "cc",
+    "ig",
+    "kl",
+    "logpolar",
+    "nss",
+    "presets",
+    "read_image",
+    "register",
+    "saliency",
+    "sauc",
+    "sim",
+    "vergence",
+]

@@ -1,0 +1,99 @@
+"""Type stubs of the Rust extension module (see the Rust docs for the algorithms)."""
+
+from os import PathLike
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+Image = Union[npt.NDArray[np.uint8], npt.NDArray[np.float32]]
+Map = npt.NDArray[np.float32]
+Fixations = Union[npt.ArrayLike, Sequence[Tuple[int, int]]]
+
+class OcellusError(ValueError): ...
+
+class SaliencyEngine:
+    def __init__(
+        self, width: int, height: int, preset: str = "ace2009", config: Optional[Dict[str, Any]] = None
+    ) -> None: ...
+    def process(self, image: Image) -> Map: ...
+    def conspicuity(self) -> Dict[str, Map]: ...
+    def full_size(self) -> Map: ...
+    def timings(self) -> Dict[str, float]: ...
+    def time_in_rust(self, image: Image, repeats: int) -> List[float]: ...
+    @property
+    def frame_size(self) -> Tuple[int, int]: ...
+    @property
+    def map_size(self) -> Tuple[int, int]: ...
+
+def saliency(
+    image: Image,
+    preset: str = "ace2009",
+    config: Optional[Dict[str, Any]] = None,
+    conspicuity: bool = False,
+    full_size: bool = False,
+) -> Union[Map, Dict[str, Any]]: ...
+def read_image(path: Union[str, PathLike[str]]) -> npt.NDArray[np.uint8]: ...
+def presets() -> List[str]: ...
+def cc(saliency: npt.ArrayLike, density: npt.ArrayLike) -> float: ...
+def sim(saliency: npt.ArrayLike, density: npt.ArrayLike) -> float: ...
+def kl(saliency: npt.ArrayLike, density: npt.ArrayLike) -> float: ...
+def nss(saliency: npt.ArrayLike, fixations: Fixations) -> float: ...
+def auc_judd(saliency: npt.ArrayLike, fixations: Fixations, seed: int = 0) -> float: ...
+def auc_borji(
+    saliency: npt.ArrayLike, fixations: Fixations, splits: int = 100, step: float = 0.1, seed: int = 0
+) -> float: ...
+def sauc(
+    saliency: npt.ArrayLike,
+    fixations: Fixations,
+    other_fixations: Fixations,
+    splits: int = 100,
+    step: float = 0.1,
+    seed: int = 0,
+) -> float: ...
+def ig(saliency: npt.ArrayLike, baseline: npt.ArrayLike, fixations: Fixations) -> float: ...
+
+class LogPolar:
+    def __init__(
+        self,
+        width: int,
+        height: int,
+        rings: int = 128,
+        sectors: int = 128,
+        fovea_radius: Optional[float] = None,
+        max_radius: Optional[float] = None,
+        fovea_rings: Optional[int] = None,
+        centre: Optional[Tuple[float, float]] = None,
+        fields: str = "pyramid",
+    ) -> None: ...
+    def forward(self, image: Image) -> Map: ...
+    def inverse(self, cortex: npt.ArrayLike) -> Map: ...
+    @property
+    def rows(self) -> int: ...
+    @property
+    def sectors(self) -> int: ...
+    @property
+    def compression_ratio(self) -> float: ...
+    @property
+    def ring_ratio(self) -> float: ...
+
+def logpolar(
+    image: Image,
+    rings: int = 128,
+    sectors: int = 128,
+    fovea_radius: Optional[float] = None,
+    max_radius: Optional[float] = None,
+    centre: Optional[Tuple[float, float]] = None,
+    fields: str = "pyramid",
+) -> Map: ...
+def register(
+    a: npt.ArrayLike, b: npt.ArrayLike, rings: int = 256, sectors: int = 512, radius_ratio: float = 40.0,
+    mode: str = "direct",
+) -> Dict[str, Any]: ...
+def vergence(
+    left: npt.NDArray[np.uint8],
+    right: npt.NDArray[np.uint8],
+    gaze: Tuple[float, float],
+    min_disparity: int = 0,
+    max_disparity: int = 64,
+) -> Dict[str, float]: ...

@@ -1,0 +1,303 @@
+//! `ocellus._ocellus`: the Python module of ocellus (PyO3 + rust-numpy).
+//!
+//! Conventions, the same as the Rust library's (`ocellus_image`): arrays are row-major
+//! (C order), indexed `[y, x]`; images are `uint8` (0..255) or `float32` (0..1) arrays of
+//! H x W (grey, replicated to R = G = B) or H x W x 3 (RGB); pixel centres sit at integer
+//! coordinates. Maps come back as `float32` arrays that own the Rust buffer (no copy).
+//! Inputs are read once into the library's planes (one copy; strided arrays are read through
+//! their strides). Every heavy call releases the GIL. Errors raise `ocellus.OcellusError`, a
+//! subclass of `ValueError`, with the library's message.
+
+use numpy::ndarray::Array2;
+use numpy::{PyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use ocellus_attention::{SaliencyConfig, SaliencyEngine as Engine};
+use ocellus_image::convert::RgbImage;
+use ocellus_image::Plane;
+use pyo3::create_exception;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+mod eval;
+mod fovea;
+
+create_exception!(
+    _ocellus,
+    OcellusError,
+    PyValueError,
+    "An error of the ocellus library (bad input, impossible parameters); the message says which."
+);
+
+/// A library error as a Python exception.
+pub(crate) fn err(e: impl std::fmt::Display) -> PyErr {
+    OcellusError::new_err(e.to_string())
+}
+
+/// An input image: a uint8 or float32 array of H x W or H x W x 3.
+pub(crate) fn image_from(obj: &Bound<'_, PyAny>) -> PyResult<RgbImage> {
+    if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, u8>>() {
+        let v = a.as_array();
+        let (h, w) = dims(a.shape(), "image")?;
+        let plane = match a.shape().len() {
+            2 => Plane::from_fn(w, h, |x, y| [v[[y, x]]; 3]),
+            _ => match a.as_slice() {
+                // C-contiguous: whole rows at once.
+                Ok(s) => Plane::from_vec(w, h, s.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()).map_err(err)?,
+                Err(_) => Plane::from_fn(w, h, |x, y| [v[[y, x, 0]], v[[y, x, 1]], v[[y, x, 2]]]),
+            },
+        };
+        return Ok(RgbImage::U8(plane));
+    }
+    if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'_, f32>>() {
+        let v = a.as_array();
+        let (h, w) = dims(a.shape(), "image")?;
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err(err("the image has NaN or infinite values"));
+        }
+        let plane = match a.shape().len() {
+            2 => Plane::from_fn(w, h, |x, y| [v[[y, x]]; 3]),
+            _ => Plane::from_fn(w, h, |x, y| [v[[y, x, 0]], v[[y, x, 1]], v[[y, x, 2]]]),
+        };
+        return Ok(RgbImage::F32(plane));
+    }
+    Err(pyo3::exceptions::PyTypeError::new_err(format!(
+        "an image must be a numpy array of uint8 or float32, got {}",
+        obj.get_type().name()?
+    )))
+}
+
+/// (height, width) of an H x W or H x W x 3 array, non-empty.
+pub(crate) fn dims(shape: &[usize], what: &str) -> PyResult<(usize, usize)> {
+    let ok = match shape {
+        [h, w] | [h, w, 3] => *h > 0 && *w > 0,
+        _ => false,
+    };
+    if !ok {
+        return Err(err(format!("{what} must be a non-empty H x W or H x W x 3 array, got shape {shape:?}")));
+    }
+    Ok((shape[0], shape[1]))
+}
+
+/// A float plane from a 2D array of any real dtype numpy can cast to float64.
+pub(crate) fn plane_f64(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Plane<f64>> {
+    let np = obj.py().import("numpy")?;
+    let a = np.call_method1("asarray", (obj, "float64"))?;
+    let a: PyReadonlyArrayDyn<'_, f64> = a.extract()?;
+    let shape = a.shape();
+    if shape.len() != 2 || shape[0] == 0 || shape[1] == 0 {
+        return Err(err(format!("{what} must be a non-empty 2D array, got shape {shape:?}")));
+    }
+    let v = a.as_array();
+    Ok(Plane::from_fn(shape[1], shape[0], |x, y| v[[y, x]]))
+}
+
+/// A float32 grey plane from a 2D array of any real dtype.
+pub(crate) fn plane_f32(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Plane<f32>> {
+    let p = plane_f64(obj, what)?;
+    if !p.as_slice().iter().all(|v| v.is_finite()) {
+        return Err(err(format!("{what} has NaN or infinite values")));
+    }
+    Ok(p.map(|v| v as f32))
+}
+
+/// A numpy array that owns `p`'s pixels (moved, not copied, when the plane is contiguous).
+pub(crate) fn to_numpy<'py>(py: Python<'py>, p: Plane<f32>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let (w, h) = p.size();
+    let a = Array2::from_shape_vec((h, w), p.into_vec()).map_err(err)?;
+    Ok(PyArray2::from_owned_array(py, a))
+}
+
+/// A saliency configuration: a preset, with a dict of overrides merged into it (nested
+/// tables merged key by key, as a configuration file over its preset).
+fn config_from(preset: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<SaliencyConfig> {
+    let cfg = SaliencyConfig::preset(preset).map_err(err)?;
+    let Some(o) = overrides else { return Ok(cfg) };
+    let json = o.py().import("json")?.call_method1("dumps", (o,))?.extract::<String>()?;
+    let over: serde_json::Value = serde_json::from_str(&json).map_err(err)?;
+    let mut base = serde_json::to_value(&cfg).map_err(err)?;
+    merge(&mut base, over);
+    let cfg: SaliencyConfig = serde_json::from_value(base).map_err(|e| err(format!("saliency configuration: {e}")))?;
+    cfg.validate().map_err(err)?;
+    Ok(cfg)
+}
+
+fn merge(base: &mut serde_json::Value, over: serde_json::Value) {
+    match (base, over) {
+        (serde_json::Value::Object(b), serde_json::Value::Object(o)) => {
+            for (k, v) in o {
+                match b.get_mut(&k) {
+                    Some(slot) if slot.is_object() && v.is_object() => merge(slot, v),
+                    _ => {
+                        b.insert(k, v);
+                    }
+                }
+            }
+        }
+        (b, o) => *b = o,
+    }
+}
+
+/// The saliency engine for frames of one size (SPEC 1): build once, then `process` each
+/// frame; all buffers are reused.
+///
+/// One engine serves one thread at a time: a call while another thread's call runs on the
+/// same engine raises `RuntimeError` (an engine per thread is the parallel pattern).
+#[pyclass(module = "ocellus._ocellus")]
+struct SaliencyEngine {
+    engine: Engine,
+}
+
+#[pymethods]
+impl SaliencyEngine {
+    /// `SaliencyEngine(width, height, preset="ace2009", config=None)`: `config` is a dict of
+    /// overrides of the preset's fields (e.g. `{"normalization": {"kind": "none"}}`).
+    #[new]
+    #[pyo3(signature = (width, height, preset = "ace2009", config = None))]
+    fn new(width: usize, height: usize, preset: &str, config: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        let cfg = config_from(preset, config)?;
+        Ok(Self { engine: Engine::new(cfg, width, height).map_err(err)? })
+    }
+
+    /// The saliency map of `image` at the map level (1/16 of the frame per side for the
+    /// presets), float32 H' x W'.
+    fn process<'py>(&mut self, py: Python<'py>, image: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let img = image_from(image)?;
+        let engine = &mut self.engine;
+        let map = py.detach(|| engine.process(&img).cloned()).map_err(err)?;
+        to_numpy(py, map)
+    }
+
+    /// The last frame's conspicuity maps, by channel name ("intensity", "colour",
+    /// "orientation", ...), after their weights.
+    fn conspicuity<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (name, m) in self.engine.conspicuity_maps() {
+            d.set_item(name, to_numpy(py, m.clone())?)?;
+        }
+        Ok(d)
+    }
+
+    /// The last saliency map resampled (bilinear) to the frame size.
+    fn full_size<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let mut out = Plane::default();
+        let engine = &mut self.engine;
+        py.detach(|| engine.saliency_full_size(&mut out)).map_err(err)?;
+        to_numpy(py, out)
+    }
+
+    /// The last frame's time per stage, milliseconds.
+    fn timings<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (name, t) in self.engine.timings().stages() {
+            d.set_item(name, t.as_secs_f64() * 1e3)?;
+        }
+        Ok(d)
+    }
+
+    /// Milliseconds of each of `repeats` calls of the engine on `image`, timed inside Rust
+    /// with no Python in the loop: the reference for the binding's overhead
+    /// (`examples/bench_overhead.py` times `process` from Python beside it).
+    fn time_in_rust(&mut self, py: Python<'_>, image: &Bound<'_, PyAny>, repeats: usize) -> PyResult<Vec<f64>> {
+        let img = image_from(image)?;
+        let engine = &mut self.engine;
+        py.detach(|| {
+            (0..repeats)
+                .map(|_| {
+                    let t = std::time::Instant::now();
+                    engine.process(&img).map(|_| t.elapsed().as_secs_f64() * 1e3)
+                })
+                .collect::<ocellus_attention::Result<Vec<f64>>>()
+        })
+        .map_err(err)
+    }
+
+    /// (width, height) of the frames this engine takes.
+    #[getter]
+    fn frame_size(&self) -> (usize, usize) {
+        self.engine.frame_size()
+    }
+
+    /// (width, height) of its maps.
+    #[getter]
+    fn map_size(&self) -> (usize, usize) {
+        self.engine.map_size()
+    }
+
+    fn __repr__(&self) -> String {
+        let ((w, h), (mw, mh)) = (self.engine.frame_size(), self.engine.map_size());
+        format!("SaliencyEngine({w}x{h} -> {mw}x{mh}, backend {})", self.engine.backend().name())
+    }
+}
+
+/// `saliency(image, preset="ace2009", config=None, conspicuity=False, full_size=False)`: the
+/// saliency map of one image (float32, at the map level). With `conspicuity` or `full_size`,
+/// a dict with "saliency" and "conspicuity" (a dict by channel) and/or "full_size".
+#[pyfunction]
+#[pyo3(signature = (image, preset = "ace2009", config = None, conspicuity = false, full_size = false))]
+fn saliency<'py>(
+    py: Python<'py>,
+    image: &Bound<'py, PyAny>,
+    preset: &str,
+    config: Option<&Bound<'py, PyDict>>,
+    conspicuity: bool,
+    full_size: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let img = image_from(image)?;
+    let (w, h) = img.size();
+    let cfg = config_from(preset, config)?;
+    let (mut engine, map) = py
+        .detach(|| -> ocellus_attention::Result<_> {
+            let mut e = Engine::new(cfg, w, h)?;
+            let m = e.process(&img)?.clone();
+            Ok((e, m))
+        })
+        .map_err(err)?;
+    if !conspicuity && !full_size {
+        return Ok(to_numpy(py, map)?.into_any());
+    }
+    let d = PyDict::new(py);
+    d.set_item("saliency", to_numpy(py, map)?)?;
+    if conspicuity {
+        let c = PyDict::new(py);
+        for (name, m) in engine.conspicuity_maps() {
+            c.set_item(name, to_numpy(py, m.clone())?)?;
+        }
+        d.set_item("conspicuity", c)?;
+    }
+    if full_size {
+        let mut out = Plane::default();
+        py.detach(|| engine.saliency_full_size(&mut out)).map_err(err)?;
+        d.set_item("full_size", to_numpy(py, out)?)?;
+    }
+    Ok(d.into_any())
+}
+
+/// `read_image(path)`: an image file (PNG, JPEG, PNM) as uint8 H x W x 3, decoded as the
+/// command-line program decodes it (16-bit files reduced to 8 bits).
+#[pyfunction]
+fn read_image<'py>(py: Python<'py>, path: std::path::PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    let img = py.detach(|| ocellus_io::read_image(&path)).map_err(err)?.to_u8();
+    let (w, h) = img.size();
+    let flat: Vec<u8> = img.into_vec().into_iter().flatten().collect();
+    let a = numpy::ndarray::Array3::from_shape_vec((h, w, 3), flat).map_err(err)?;
+    Ok(numpy::PyArray3::from_owned_array(py, a).into_any())
+}
+
+/// The saliency presets.
+#[pyfunction]
+fn presets() -> Vec<&'static str> {
+    SaliencyConfig::PRESETS.to_vec()
+}
+
+/// The module.
+#[pymodule]
+fn _ocellus(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("OcellusError", m.py().get_type::<OcellusError>())?;
+    m.add_class::<SaliencyEngine>()?;
+    m.add_function(wrap_pyfunction!(saliency, m)?)?;
+    m.add_function(wrap_pyfunction!(read_image, m)?)?;
+    m.add_function(wrap_pyfunction!(presets, m)?)?;
+    eval::register(m)?;
+    fovea::register_module(m)?;
+    Ok(())
+}
