@@ -218,3 +218,18 @@ impl Plane<f32> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn into_vec_gives_the_rows_in_order_strided_or_not() {
+        let p = Plane::from_fn(3, 2, |x, y| (10 * y + x) as u32);
+        assert_eq!(p.clone().into_vec(), vec![0, 1, 2, 10, 11, 12]);
+        // Rows 5 apart in the buffer: compacted.
+        let data = vec![0, 1, 2, 99, 99, 10, 11, 12, 99, 99];
+        let s = Plane::from_vec_with_stride(3, 2, 5, data).unwrap();
+        assert_eq!(s.into_vec(), p.to_vec());
+    }
+}
