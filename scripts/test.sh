@@ -47,14 +47,15 @@ done
 rm -f "$log.example"
 # The Python package (python/): a virtual environment filled from the package registry, the
 # wheel built by maturin and installed (`pip install ./python`), then pytest. The tests compare
-# with the command-line program the cargo tests built.
+# with the command-line program the cargo tests built, and run the Ray example on a local Ray.
 py_passed=0
 if [ "$status" -eq 0 ]; then
   venv=target/python-venv
   [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check numpy pytest
+  # Ray Data (with Pillow, its image reader) for the distributed example's test.
+  "$venv/bin/pip" install -q --disable-pip-version-check numpy pytest pillow "ray[data]"
   if "$venv/bin/pip" install -q --disable-pip-version-check ./python \
-    && OCELLUS_BIN="$PWD/target/debug/ocellus" "$venv/bin/python" -m pytest -q python/tests > "$log.py" 2>&1; then
+    && OCELLUS_BIN="$PWD/target/debug/ocellus" OCELLUS_REQUIRE_RAY=1 "$venv/bin/python" -m pytest -q python/tests > "$log.py" 2>&1; then
     py_passed=$(grep -Eo '[0-9]+ passed' "$log.py" | grep -Eo '[0-9]+' || echo 0)
   else
     cat "$log.py" 2>/dev/null || true

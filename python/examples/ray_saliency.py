@@ -1,0 +1,139 @@
+"""Saliency maps of an image corpus on a Ray cluster: one ocellus engine per worker.
+
+    python ray_saliency.py IMAGES OUT [--fixations DIR] [--address ADDRESS] [--preset ace2009]
+
+IMAGES is a folder, a file, or several of them (anything `ray.data.read_images` reads: local
+paths, or s3:// and gs:// URIs on a cluster that can reach them). For each image it writes one
+Parquet row to OUT: the path, the image size, the saliency map (float32, flattened, with its
+width and height), its peak in image pixels, and, when --fixations names a folder of human
+fixation density maps with the same file stems (e.g. MIT1003's), the CC, SIM and KL of the
+full-size saliency map against them.
+
+On an existing cluster pass its address (`--address auto` on a cluster node, or
+`--address ray://HEAD:10001` from outside); without one, Ray starts a local instance on this
+machine's cores. Each worker keeps one `ocellus.SaliencyEngine` per image size, so a corpus of
+one size builds one engine per worker.
+"""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+from typing import Dict, List, Optional
+
+import numpy as np
+
+import ocellus
+
+
+def density_for(fixations: Optional[str], image_path: str) -> Optional[np.ndarray]:
+    """The fixation density map with the image's file stem in `fixations`, as float64, or None."""
+    if not fixations:
+        return None
+    matches = sorted(pathlib.Path(fixations).glob(pathlib.Path(image_path).stem + ".*"))
+    if not matches:
+        return None
+    from PIL import Image  # Ray's image reader needs Pillow anyway
+
+    return np.asarray(Image.open(matches[0]).convert("L"), dtype=np.float64)
+
+
+def score_image(
+    image: np.ndarray, engines: Dict[tuple, ocellus.SaliencyEngine], preset: str, density: Optional[np.ndarray]
+) -> dict:
+    """The saliency map of one H x W x 3 uint8 image and, with a density map, CC / SIM / KL."""
+    h, w = image.shape[:2]
+    engine = engines.get((w, h))
+    if engine is None:
+        engine = engines[(w, h)] = ocellus.SaliencyEngine(w, h, preset=preset)
+    m = engine.process(np.ascontiguousarray(image))
+    full = engine.full_size()
+    py, px = np.unravel_index(int(np.argmax(full)), full.shape)
+    row = {
+        "width": w,
+        "height": h,
+        "map_width": m.shape[1],
+        "map_height": m.shape[0],
+        "saliency": m.ravel(),
+        "peak_x": int(px),
+        "peak_y": int(py),
+        "cc": float("nan"),
+        "sim": float("nan"),
+        "kl": float("nan"),
+    }
+    if density is not None:
+        if density.shape != full.shape:
+            raise ocellus.OcellusError(f"fixation map of {density.shape} for an image of {full.shape}")
+        row["cc"] = ocellus.cc(full, density)
+        row["sim"] = ocellus.sim(full, density)
+        row["kl"] = ocellus.kl(full, density)
+    return row
+
+
+class SaliencyWorker:
+    """A Ray Data UDF: one worker's engines, applied to batches of images."""
+
+    def __init__(self, preset: str = "ace2009", fixations: Optional[str] = None):
+        self.preset = preset
+        self.fixations = fixations
+        self.engines: Dict[tuple, ocellus.SaliencyEngine] = {}
+
+    def __call__(self, batch: Dict[str, np.ndarray]) -> Dict[str, list]:
+        rows: List[dict] = []
+        for image, path in zip(batch["image"], batch["path"]):
+            row = score_image(image, self.engines, self.preset, density_for(self.fixations, str(path)))
+            row["path"] = str(path)
+            rows.append(row)
+        return {k: [r[k] for r in rows] for k in rows[0]} if rows else {}
+
+
+def run(
+    images,
+    out: str,
+    fixations: Optional[str] = None,
+    preset: str = "ace2009",
+    address: Optional[str] = None,
+    num_cpus: Optional[int] = None,
+    workers: int = 2,
+) -> None:
+    """Reads `images` with Ray Data, scores them on `workers` actors, writes Parquet to `out`."""
+    import sys
+
+    import ray
+
+    # Workers may not have this file: ship its code with the task (a script run as
+    # __main__ is shipped so anyway).
+    if __name__ != "__main__":
+        ray.cloudpickle.register_pickle_by_value(sys.modules[__name__])
+    if not ray.is_initialized():
+        ray.init(address=address, num_cpus=num_cpus, include_dashboard=False, log_to_driver=False)
+    # One CPU stays free for reading and decoding: actors holding every CPU would starve the
+    # read tasks (on a small local instance, the pipeline would wait forever).
+    cpus = int(ray.cluster_resources().get("CPU", 1))
+    workers = max(1, min(workers, cpus - 1))
+    ds = ray.data.read_images(images, mode="RGB", include_paths=True)
+    scored = ds.map_batches(
+        SaliencyWorker,
+        fn_constructor_kwargs={"preset": preset, "fixations": fixations},
+        batch_size=4,
+        batch_format="numpy",
+        concurrency=workers,
+        num_cpus=1,
+    )
+    scored.write_parquet(out)
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("images", nargs="+", help="image folders, files or URIs")
+    p.add_argument("out", help="output folder for the Parquet files")
+    p.add_argument("--fixations", help="folder of fixation density maps named like the images")
+    p.add_argument("--preset", default="ace2009", choices=ocellus.presets())
+    p.add_argument("--address", help="an existing Ray cluster (e.g. auto or ray://HEAD:10001)")
+    p.add_argument("--workers", type=int, default=2, help="actors, each with its own engines")
+    a = p.parse_args()
+    run(a.images, a.out, a.fixations, a.preset, a.address, workers=a.workers)
+
+
+if __name__ == "__main__":
+    main()
