@@ -42,7 +42,7 @@ pub(crate) fn image_from(obj: &Bound<'_, PyAny>) -> PyResult<RgbImage> {
             2 => Plane::from_fn(w, h, |x, y| [v[[y, x]]; 3]),
             _ => match a.as_slice() {
                 // C-contiguous: whole rows at once.
-                Ok(s) => Plane::from_vec(w, h, s.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect()).map_err(err)?,
+                Ok(s) => Plane::from_vec(w, h, rgb_pixels(s)).map_err(err)?,
                 Err(_) => Plane::from_fn(w, h, |x, y| [v[[y, x, 0]], v[[y, x, 1]], v[[y, x, 2]]]),
             },
         };
@@ -64,6 +64,13 @@ pub(crate) fn image_from(obj: &Bound<'_, PyAny>) -> PyResult<RgbImage> {
         "an image must be a numpy array of uint8 or float32, got {}",
         obj.get_type().name()?
     )))
+}
+
+/// Interleaved RGB bytes as pixels: one memcpy (`[u8; 3]` has the bytes' layout), not a
+/// loop over pixels.
+fn rgb_pixels(bytes: &[u8]) -> Vec<[u8; 3]> {
+    let (pixels, _) = bytes.as_chunks::<3>();
+    pixels.to_vec()
 }
 
 /// (height, width) of an H x W or H x W x 3 array, non-empty.
