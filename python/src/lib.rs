@@ -20,6 +20,7 @@ use pyo3::types::PyDict;
 
 mod eval;
 mod fovea;
+mod geometry;
 
 create_exception!(
     _ocellus,
@@ -306,5 +307,6 @@ fn _ocellus(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(presets, m)?)?;
     eval::register(m)?;
     fovea::register_module(m)?;
+    geometry::register(m)?;
     Ok(())
 }
