@@ -7,8 +7,10 @@ Errors raise :class:`OcellusError` (a ``ValueError``) with the library's message
 """
 
 from ._ocellus import (
+    GroundSequence,
     LogPolar,
     OcellusError,
+    Odometry,
     SaliencyEngine,
     auc_borji,
     auc_judd,
@@ -34,8 +36,10 @@ from ._ocellus import (
 )
 
 __all__ = [
+    "GroundSequence",
     "LogPolar",
     "OcellusError",
+    "Odometry",
     "SaliencyEngine",
     "auc_borji",
     "auc_judd",

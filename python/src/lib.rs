@@ -21,6 +21,7 @@ use pyo3::types::PyDict;
 mod eval;
 mod fovea;
 mod geometry;
+mod odometry;
 
 create_exception!(
     _ocellus,
@@ -308,5 +309,6 @@ fn _ocellus(m: &Bound<'_, PyModule>) -> PyResult<()> {
     eval::register(m)?;
     fovea::register_module(m)?;
     geometry::register(m)?;
+    odometry::register(m)?;
     Ok(())
 }

@@ -92,3 +92,28 @@ def test_stereo_on_the_motorcycle_pair():
         assert valid.mean() > 0.5 and d[valid].min() >= 0.0 and d[valid].max() < 128.0
     with pytest.raises(ocellus.OcellusError):
         ocellus.stereo_sgm(left, right[:, :100])
+
+
+def test_odometry_on_a_generated_floor_equals_the_command_line(cli, tmp_path):
+    seq = ocellus.GroundSequence(frames=40, seed=2)
+    assert len(seq) == 40
+    subprocess.run([cli, "generate", "ground", "--frames", "40", "--seed", "2", "--out", str(tmp_path / "g")],
+                   check=True, capture_output=True)
+    # The same frames as the generator's PNGs, bit for bit.
+    first = ocellus.read_image(tmp_path / "g" / "frames" / "frame_00000.png")[:, :, 0]
+    assert np.array_equal(seq.frame(0), first)
+    cam = seq.camera
+    vo = ocellus.Odometry(cam["height_m"], cam["focal_px"], mount=cam["mount"])
+    poses = [vo.step(seq.frame(k))["pose"] for k in range(len(seq))]
+    truth = [seq.pose(k) for k in range(len(seq))]
+    path = sum(np.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(truth, truth[1:]))
+    drift = np.hypot(poses[-1][0] - truth[-1][0], poses[-1][1] - truth[-1][1]) / path
+    assert path > 0.05 and drift < 0.01
+    subprocess.run([cli, "odometry", str(tmp_path / "g" / "frames"), "--camera", str(tmp_path / "g" / "camera.toml"),
+                    "--out", str(tmp_path / "o")], check=True, capture_output=True)
+    tum = np.loadtxt(tmp_path / "o" / "trajectory.tum", comments="#")
+    assert np.allclose(tum[:, 1:3], np.array(poses)[:, :2], atol=2e-9)
+    with pytest.raises(ocellus.OcellusError):
+        ocellus.Odometry(-0.3, 600.0)
+    with pytest.raises(IndexError):
+        seq.frame(40)
