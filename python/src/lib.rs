@@ -22,6 +22,7 @@ mod eval;
 mod fovea;
 mod geometry;
 mod odometry;
+mod stream;
 
 create_exception!(
     _ocellus,
@@ -130,7 +131,8 @@ fn config_from(preset: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<
     Ok(cfg)
 }
 
-fn merge(base: &mut serde_json::Value, over: serde_json::Value) {
+/// Merges `over` into `base`: objects key by key, anything else replaced.
+pub(crate) fn merge(base: &mut serde_json::Value, over: serde_json::Value) {
     match (base, over) {
         (serde_json::Value::Object(b), serde_json::Value::Object(o)) => {
             for (k, v) in o {
@@ -310,5 +312,6 @@ fn _ocellus(m: &Bound<'_, PyModule>) -> PyResult<()> {
     fovea::register_module(m)?;
     geometry::register(m)?;
     odometry::register(m)?;
+    stream::register(m)?;
     Ok(())
 }
