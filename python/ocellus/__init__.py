@@ -7,6 +7,7 @@ Errors raise :class:`OcellusError` (a ``ValueError``) with the library's message
 """
 
 from ._ocellus import (
+    BallTracker,
     GroundSequence,
     LogPolar,
     OcellusError,
@@ -19,6 +20,7 @@ from ._ocellus import (
     cc,
     decompose,
     dlt,
+    effective_sample_size,
     ig,
     kl,
     logpolar,
@@ -26,6 +28,7 @@ from ._ocellus import (
     presets,
     read_image,
     register,
+    resample,
     saliency,
     sauc,
     sim,
@@ -37,6 +40,7 @@ from ._ocellus import (
 )
 
 __all__ = [
+    "BallTracker",
     "GroundSequence",
     "LogPolar",
     "OcellusError",
@@ -49,6 +53,7 @@ __all__ = [
     "cc",
     "decompose",
     "dlt",
+    "effective_sample_size",
     "ig",
     "kl",
     "logpolar",
@@ -56,6 +61,7 @@ __all__ = [
     "presets",
     "read_image",
     "register",
+    "resample",
     "saliency",
     "sauc",
     "sim",

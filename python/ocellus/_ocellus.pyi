@@ -131,3 +131,27 @@ class StreamEngine:
     def reset_temporal(self) -> None: ...
     @property
     def frames(self) -> int: ...
+
+def resample(weights: Sequence[float], scheme: str = "systematic", seed: int = 1) -> List[int]: ...
+def effective_sample_size(weights: Sequence[float]) -> float: ...
+
+class BallTracker:
+    def __init__(
+        self,
+        k: npt.ArrayLike,
+        radius_m: float,
+        colour: Optional[Tuple[int, int, int]] = None,
+        patch: Optional[Tuple[Image, float, float, float]] = None,
+        distortion: Optional[Sequence[float]] = None,
+        particles: int = 4000,
+        boost: float = 0.2,
+        fps: float = 30.0,
+        seed: int = 1,
+        gravity: float = 0.0,
+        accel_sigma: float = 10.0,
+        floor_y: Optional[float] = None,
+        restitution: float = 0.8,
+    ) -> None: ...
+    def process(self, frame: Image) -> Dict[str, Any]: ...
+    @property
+    def particles(self) -> npt.NDArray[np.float64]: ...

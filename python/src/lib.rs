@@ -23,6 +23,7 @@ mod fovea;
 mod geometry;
 mod odometry;
 mod stream;
+mod tracking;
 
 create_exception!(
     _ocellus,
@@ -313,5 +314,6 @@ fn _ocellus(m: &Bound<'_, PyModule>) -> PyResult<()> {
     geometry::register(m)?;
     odometry::register(m)?;
     stream::register(m)?;
+    tracking::register(m)?;
     Ok(())
 }
