@@ -118,35 +118,19 @@ pub(crate) fn to_numpy<'py>(py: Python<'py>, p: Plane<f32>) -> PyResult<Bound<'p
     Ok(PyArray2::from_owned_array(py, a))
 }
 
-/// A saliency configuration: a preset, with a dict of overrides merged into it (nested
-/// tables merged key by key, as a configuration file over its preset).
-fn config_from(preset: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<SaliencyConfig> {
-    let cfg = SaliencyConfig::preset(preset).map_err(err)?;
-    let Some(o) = overrides else { return Ok(cfg) };
-    let json = o.py().import("json")?.call_method1("dumps", (o,))?.extract::<String>()?;
-    let over: serde_json::Value = serde_json::from_str(&json).map_err(err)?;
-    let mut base = serde_json::to_value(&cfg).map_err(err)?;
-    merge(&mut base, over);
-    let cfg: SaliencyConfig = serde_json::from_value(base).map_err(|e| err(format!("saliency configuration: {e}")))?;
-    cfg.validate().map_err(err)?;
-    Ok(cfg)
+/// A dict as a JSON value (through Python's json module: every value a dict of numbers,
+/// strings, lists and dicts can hold).
+pub(crate) fn json_of(d: &Bound<'_, PyDict>) -> PyResult<serde_json::Value> {
+    let text = d.py().import("json")?.call_method1("dumps", (d,))?.extract::<String>()?;
+    serde_json::from_str(&text).map_err(err)
 }
 
-/// Merges `over` into `base`: objects key by key, anything else replaced.
-pub(crate) fn merge(base: &mut serde_json::Value, over: serde_json::Value) {
-    match (base, over) {
-        (serde_json::Value::Object(b), serde_json::Value::Object(o)) => {
-            for (k, v) in o {
-                match b.get_mut(&k) {
-                    Some(slot) if slot.is_object() && v.is_object() => merge(slot, v),
-                    _ => {
-                        b.insert(k, v);
-                    }
-                }
-            }
-        }
-        (b, o) => *b = o,
-    }
+/// A saliency configuration: a preset with a dict of overrides, by the command-line
+/// program's rule (`ocellus_attention::overrides`: nested tables merged key by key, channels
+/// added by kind unless `replace_channels`).
+fn config_from(preset: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<SaliencyConfig> {
+    let over = overrides.map(json_of).transpose()?.unwrap_or(serde_json::Value::Null);
+    ocellus_attention::overrides::saliency_config(preset, over).map_err(err)
 }
 
 /// The saliency engine for frames of one size (SPEC 1): build once, then `process` each

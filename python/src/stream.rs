@@ -2,7 +2,8 @@
 //! surprise, the context chaos degree and winner-take-all with habituation and inhibition of
 //! return on an ego-sphere, frame by frame in order.
 
-use crate::{err, image_from, merge, to_numpy};
+use crate::{err, image_from, json_of, to_numpy};
+use ocellus_attention::overrides::merge;
 use ocellus_attention::stream::{StreamConfig, StreamEngine as Engine};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -23,10 +24,8 @@ impl StreamEngine {
     fn new(width: usize, height: usize, config: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let mut cfg = StreamConfig::default();
         if let Some(o) = config {
-            let json = o.py().import("json")?.call_method1("dumps", (o,))?.extract::<String>()?;
-            let over: serde_json::Value = serde_json::from_str(&json).map_err(err)?;
             let mut base = serde_json::to_value(&cfg).map_err(err)?;
-            merge(&mut base, over);
+            merge(&mut base, json_of(o)?);
             cfg = serde_json::from_value(base).map_err(|e| err(format!("stream configuration: {e}")))?;
         }
         Ok(Self { engine: Engine::new(cfg, width, height).map_err(err)? })

@@ -38,6 +38,9 @@ def test_the_engine_and_the_function_agree_and_give_every_output(photo):
     assert other.shape == m.shape and not np.array_equal(other, m)
     stb = ocellus.saliency(photo, preset="stb")
     assert stb.shape == m.shape
+    # Channels add by kind, as in a --config file: a skin channel joins the three.
+    skin = ocellus.saliency(photo, config={"channels": [{"kind": "skin", "weight": 0.5}]}, conspicuity=True)
+    assert len(skin["conspicuity"]) == 4
 
 
 def test_outputs_own_the_rust_buffer(photo):

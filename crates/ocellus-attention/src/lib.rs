@@ -29,6 +29,7 @@ pub mod config;
 pub mod egosphere;
 pub mod gabor;
 pub mod normalize;
+pub mod overrides;
 pub mod planning;
 pub mod saliency;
 pub mod stream;

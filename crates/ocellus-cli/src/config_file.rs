@@ -1,66 +1,23 @@
 //! Saliency configuration from a preset name plus an optional TOML file of overrides.
 
 use anyhow::{Context, Result};
-use ocellus_attention::SaliencyConfig;
+use ocellus_attention::{overrides, SaliencyConfig};
 use std::path::Path;
-
-/// Deep-merges `over` into `base` (tables merge key by key; other values replace).
-fn merge(base: &mut toml::Value, over: toml::Value) {
-    match (base, over) {
-        (toml::Value::Table(b), toml::Value::Table(o)) => {
-            for (k, v) in o {
-                match b.get_mut(&k) {
-                    Some(bv) if bv.is_table() && v.is_table() => merge(bv, v),
-                    _ => {
-                        b.insert(k, v);
-                    }
-                }
-            }
-        }
-        (b, o) => *b = o,
-    }
-}
-
-/// Adds the `[[channels]]` of an override to the preset's channels: an entry of a kind the
-/// preset has replaces that channel (to change its weight), any other is appended. The README's
-/// example, a skin channel, thus keeps intensity, colour and orientation.
-fn merge_channels(base: &mut toml::Value, over: &mut toml::Value) {
-    let Some(new) = over.as_table_mut().and_then(|t| t.remove("channels")) else { return };
-    let Some(list) = base.get_mut("channels").and_then(toml::Value::as_array_mut) else { return };
-    for entry in new.as_array().cloned().unwrap_or_default() {
-        match list.iter_mut().find(|c| c.get("kind").is_some() && c.get("kind") == entry.get("kind")) {
-            Some(existing) => *existing = entry,
-            None => list.push(entry),
-        }
-    }
-}
 
 /// The preset `preset`, with the fields given in the TOML file `file` replaced.
 ///
 /// The file uses the field names of `SaliencyConfig` (see `ocellus saliency --print-config`),
 /// e.g. `map_level = 3` or `[gabor]\nsize = 15`. `[[channels]]` entries add to the preset's
 /// channels (an entry of a kind the preset has replaces that one); with
-/// `replace_channels = true` at the top of the file they replace the whole list.
+/// `replace_channels = true` at the top of the file they replace the whole list
+/// (`ocellus_attention::overrides`, the rule the Python package's `config=` follows too).
 pub fn load(preset: &str, file: Option<&Path>) -> Result<SaliencyConfig> {
-    let base = SaliencyConfig::preset(preset)?;
-    let Some(file) = file else { return Ok(base) };
+    let Some(file) = file else { return Ok(SaliencyConfig::preset(preset)?) };
     let text = std::fs::read_to_string(file).with_context(|| format!("cannot read config file {}", file.display()))?;
-    let mut over: toml::Value =
-        toml::from_str(&text).with_context(|| format!("{} is not valid TOML", file.display()))?;
-    let replace = match over.as_table_mut().and_then(|t| t.remove("replace_channels")) {
-        None => false,
-        Some(toml::Value::Boolean(b)) => b,
-        Some(v) => anyhow::bail!("{}: replace_channels must be true or false, not {v}", file.display()),
-    };
-    let mut value = toml::Value::try_from(&base).context("cannot serialize preset")?;
-    if !replace {
-        merge_channels(&mut value, &mut over);
-    }
-    merge(&mut value, over);
-    let cfg: SaliencyConfig =
-        value.try_into().with_context(|| format!("{}: invalid saliency configuration", file.display()))?;
-    cfg.validate()?;
-    Ok(cfg)
+    let over: toml::Value = toml::from_str(&text).with_context(|| format!("{} is not valid TOML", file.display()))?;
+    let over = serde_json::to_value(over).with_context(|| format!("{}: cannot read its values", file.display()))?;
+    overrides::saliency_config(preset, over)
+        .with_context(|| format!("{}: invalid saliency configuration", file.display()))
 }
 
 /// The configuration as TOML text.
