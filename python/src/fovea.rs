@@ -53,6 +53,7 @@ impl LogPolar {
         centre: Option<(f64, f64)>,
         fields: &str,
     ) -> PyResult<Self> {
+        crate::check_frame_size(width, height)?;
         let mut cfg = LogPolarConfig { rings, sectors, ..LogPolarConfig::for_image(width, height) };
         if let Some(r) = max_radius {
             cfg.max_radius = r;

@@ -77,6 +77,16 @@ fn rgb_pixels(bytes: &[u8]) -> Vec<[u8; 3]> {
     pixels.to_vec()
 }
 
+/// Refuses frame sizes whose buffers could not be allocated (an allocation failure would abort
+/// the interpreter): at most `ocellus_io::DEFAULT_MAX_PIXELS` pixels, as images read from files.
+pub(crate) fn check_frame_size(width: usize, height: usize) -> PyResult<()> {
+    let pixels = (width as u64).saturating_mul(height as u64);
+    if width == 0 || height == 0 || pixels > ocellus_io::DEFAULT_MAX_PIXELS {
+        return Err(err(format!("a {width}x{height} frame: need 1..={} pixels", ocellus_io::DEFAULT_MAX_PIXELS)));
+    }
+    Ok(())
+}
+
 /// (height, width) of an H x W or H x W x 3 array, non-empty.
 pub(crate) fn dims(shape: &[usize], what: &str) -> PyResult<(usize, usize)> {
     let ok = match shape {
@@ -150,6 +160,7 @@ impl SaliencyEngine {
     #[new]
     #[pyo3(signature = (width, height, preset = "ace2009", config = None))]
     fn new(width: usize, height: usize, preset: &str, config: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        check_frame_size(width, height)?;
         let cfg = config_from(preset, config)?;
         Ok(Self { engine: Engine::new(cfg, width, height).map_err(err)? })
     }

@@ -22,6 +22,7 @@ impl StreamEngine {
     #[new]
     #[pyo3(signature = (width, height, config = None))]
     fn new(width: usize, height: usize, config: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
+        crate::check_frame_size(width, height)?;
         let mut cfg = StreamConfig::default();
         if let Some(o) = config {
             let mut base = serde_json::to_value(&cfg).map_err(err)?;

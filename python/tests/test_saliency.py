@@ -114,3 +114,21 @@ def test_one_engine_in_two_threads_works_or_raises(photo):
         t.join()
     assert len(results) + len(errors) == 10 and results
     assert all(np.array_equal(r, expected) for r in results)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: ocellus.SaliencyEngine(0, 480),
+        lambda: ocellus.SaliencyEngine(10**6, 10**6),  # would need terabytes: refused, not aborted
+        lambda: ocellus.StreamEngine(10**6, 10**6),
+        lambda: ocellus.LogPolar(10**6, 10**6),
+        lambda: ocellus.LogPolar(300, 300, rings=0),
+        lambda: ocellus.SaliencyEngine(640, 480, config={"map_level": -1}),
+        lambda: ocellus.GroundSequence(frames=0),
+        lambda: ocellus.Odometry(0.3, float("inf")),
+    ],
+)
+def test_impossible_engines_raise_instead_of_crashing(make):
+    with pytest.raises(ocellus.OcellusError):
+        make()
