@@ -53,6 +53,141 @@ fn effective_sample_size(weights: Vec<f64>) -> PyResult<f64> {
     Ok(1.0 / w.iter().map(|v| v * v).sum::<f64>())
 }
 
+/// A generic particle filter over states of D numbers (SPEC 7.1), with the model written
+/// over the whole cloud in numpy: `ParticleFilter(states, resample_below=0.5,
+/// scheme="systematic", seed=1)`, `states` N x D. Weights are kept as logs; the filter
+/// resamples when the ESS falls below `resample_below` x N (1: the seed's SIR, every step;
+/// 0: SIS, never).
+#[pyclass(module = "ocellus._ocellus")]
+struct ParticleFilter {
+    filter: ocellus_estimation::particle_filter::ParticleFilter<Vec<f64>>,
+    dim: usize,
+}
+
+/// The rows of an N x D float64 array (any real dtype) with `n` rows, or any `n` when None.
+fn cloud(obj: &Bound<'_, PyAny>, n: Option<usize>, dim: Option<usize>) -> PyResult<Vec<Vec<f64>>> {
+    let np = obj.py().import("numpy")?;
+    let a = np.call_method1("asarray", (obj, "float64"))?;
+    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+    let ok = shape.len() == 2
+        && shape[0] > 0
+        && shape[1] > 0
+        && n.is_none_or(|n| shape[0] == n)
+        && dim.is_none_or(|d| shape[1] == d);
+    if !ok {
+        return Err(err(format!("states must be an N x D array (N = {n:?}, D = {dim:?}), got shape {shape:?}")));
+    }
+    let rows: Vec<Vec<f64>> = a.call_method0("tolist")?.extract()?;
+    if rows.iter().flatten().any(|v| v.is_nan()) {
+        return Err(err("states hold NaN"));
+    }
+    Ok(rows)
+}
+
+/// A length-`n` float64 vector from a sequence or array (a scalar 0 is not allowed).
+fn vector(obj: &Bound<'_, PyAny>, n: usize, what: &str) -> PyResult<Vec<f64>> {
+    let np = obj.py().import("numpy")?;
+    let v: Vec<f64> =
+        np.call_method1("asarray", (obj, "float64"))?.call_method0("ravel")?.call_method0("tolist")?.extract()?;
+    if v.len() != n {
+        return Err(err(format!("{what} has {} entries for {n} particles", v.len())));
+    }
+    Ok(v)
+}
+
+fn states_array<'py>(py: Python<'py>, s: &[Vec<f64>], dim: usize) -> Bound<'py, PyArray2<f64>> {
+    PyArray2::from_owned_array(py, Array2::from_shape_fn((s.len(), dim), |(i, j)| s[i][j]))
+}
+
+#[pymethods]
+impl ParticleFilter {
+    #[new]
+    #[pyo3(signature = (states, resample_below = 0.5, scheme = "systematic", seed = 1))]
+    fn new(states: &Bound<'_, PyAny>, resample_below: f64, scheme: &str, seed: u64) -> PyResult<Self> {
+        let s = cloud(states, None, None)?;
+        let dim = s[0].len();
+        if !(0.0..=1.0).contains(&resample_below) {
+            return Err(err(format!("resample_below {resample_below} is outside [0, 1]")));
+        }
+        let resampler = match scheme {
+            "systematic" => Resampler::Systematic,
+            "stratified" => Resampler::Stratified,
+            "multinomial" => Resampler::Multinomial,
+            "residual" => Resampler::Residual,
+            other => return Err(err(format!("scheme {other:?}: systematic, stratified, multinomial or residual"))),
+        };
+        let cfg = ocellus_estimation::particle_filter::FilterConfig { resample_below, resampler, seed };
+        let filter = ocellus_estimation::particle_filter::ParticleFilter::new(cfg, s).map_err(err)?;
+        Ok(Self { filter, dim })
+    }
+
+    /// One step: `propose(states) -> new_states` (N x D; or `(new_states, log_ratio)` with
+    /// `log_ratio[i] = ln p(x_i | x'_i) - ln q(x_i | x'_i, z)` for a proposal other than the
+    /// motion model), then `log_likelihood(new_states) -> (N,)`, `ln p(z | x_i)`. Returns
+    /// {"ess" (before resampling), "resampled", "log_evidence"}. The callables hold the
+    /// GIL; draw their randomness from a seeded numpy Generator for reproducible runs.
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        propose: &Bound<'py, PyAny>,
+        log_likelihood: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (n, dim) = (self.filter.particles().len(), self.dim);
+        let out = propose.call1((states_array(py, self.filter.particles(), dim),))?;
+        let (moved, ratio) = match out.extract::<(Bound<'py, PyAny>, Bound<'py, PyAny>)>() {
+            Ok((s, r)) if out.is_instance_of::<pyo3::types::PyTuple>() => (s, Some(r)),
+            _ => (out, None),
+        };
+        let moved = cloud(&moved, Some(n), Some(dim))?;
+        let ratio = ratio.map(|r| vector(&r, n, "the proposal's log ratio")).transpose()?;
+        let mut moved = Some(moved);
+        self.filter.propose_with(|p, inc| {
+            if let Some(m) = moved.take() {
+                p.iter_mut().zip(m).for_each(|(a, b)| *a = b);
+            }
+            if let Some(r) = &ratio {
+                inc.copy_from_slice(r);
+            }
+        });
+        let ll = log_likelihood.call1((states_array(py, self.filter.particles(), dim),))?;
+        let ll = vector(&ll, n, "the log likelihood")?;
+        let report = self.filter.weigh_proposed_with(|_, out| out.copy_from_slice(&ll)).map_err(err)?;
+        let d = PyDict::new(py);
+        d.set_item("ess", report.ess)?;
+        d.set_item("resampled", report.resampled)?;
+        d.set_item("log_evidence", report.log_evidence)?;
+        Ok(d)
+    }
+
+    /// The particles, N x D.
+    #[getter]
+    fn states<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        states_array(py, self.filter.particles(), self.dim)
+    }
+
+    /// The normalized weights.
+    #[getter]
+    fn weights(&self) -> Vec<f64> {
+        self.filter.weights()
+    }
+
+    /// The effective sample size of the current weights, particles.
+    #[getter]
+    fn ess(&self) -> f64 {
+        self.filter.ess()
+    }
+
+    /// The weighted mean state.
+    fn mean(&self) -> Vec<f64> {
+        let w = self.filter.weights();
+        let mut m = vec![0.0; self.dim];
+        for (p, wi) in self.filter.particles().iter().zip(w) {
+            m.iter_mut().zip(p).for_each(|(a, v)| *a += wi * v);
+        }
+        m
+    }
+}
+
 /// The 3D ball tracker (SPEC 7.3, 7.4): a particle filter over the ball's centre and
 /// velocity in the camera frame (metres, y down), weighed by the colour likelihood of its
 /// image circle, boosted by colour-blob detections. `BallTracker(K, radius_m, colour=None,
@@ -153,5 +288,6 @@ impl BallTracker {
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(resample, m)?)?;
     m.add_function(wrap_pyfunction!(effective_sample_size, m)?)?;
+    m.add_class::<ParticleFilter>()?;
     m.add_class::<BallTracker>()
 }

@@ -58,3 +58,35 @@ def test_the_ball_tracker_follows_the_command_line(cli, tmp_path):
         ocellus.BallTracker(k, 0.05, colour=(128, 128, 128))  # grey: no hue
     with pytest.raises(ocellus.OcellusError):
         ocellus.BallTracker(k, 0.05, colour=(250, 120, 20), particles=0)
+
+
+def test_a_numpy_model_in_the_particle_filter_tracks_as_the_kalman_filter():
+    # x_t = x_(t-1) + N(0, q), z_t = x_t + N(0, r): the posterior is the Kalman filter's.
+    q, r, n = 0.5, 1.0, 20000
+    rng = np.random.default_rng(11)
+    truth = np.cumsum(rng.normal(0, np.sqrt(q), 10))
+    zs = truth + rng.normal(0, np.sqrt(r), 10)
+    pf = ocellus.ParticleFilter(rng.normal(0.0, 1.0, (n, 1)), resample_below=1.0)
+    m, p = 0.0, 1.0
+    for z in zs:
+        pf.step(lambda s: s + rng.normal(0, np.sqrt(q), s.shape), lambda s: -0.5 * (s[:, 0] - z) ** 2 / r)
+        p = p + q
+        k = p / (p + r)
+        m, p = m + k * (z - m), (1 - k) * p
+        assert pf.mean()[0] == pytest.approx(m, abs=0.05)
+    assert pf.states.shape == (n, 1) and pf.ess == pytest.approx(n)  # resampled every step
+
+
+def test_the_sis_weight_update_is_the_hand_computation():
+    pf = ocellus.ParticleFilter([[0.0], [1.0], [2.0], [3.0]], resample_below=0.0)
+    report = pf.step(lambda s: (s + 0.5, [0.0, 0.0, 0.0, -1.0]), lambda s: -0.5 * (s[:, 0] - 2.0) ** 2)
+    x = np.array([0.5, 1.5, 2.5, 3.5])
+    w = np.exp(-0.5 * (x - 2.0) ** 2 - [0.0, 0.0, 0.0, 1.0])
+    assert np.allclose(pf.weights, w / w.sum(), atol=1e-12) and not report["resampled"]
+    assert report["ess"] == pytest.approx(1.0 / np.sum((w / w.sum()) ** 2))
+    with pytest.raises(ocellus.OcellusError):
+        pf.step(lambda s: s[:2], lambda s: np.zeros(len(s)))  # lost particles
+    with pytest.raises(ocellus.OcellusError):
+        pf.step(lambda s: s, lambda s: np.full(len(s), np.nan))
+    with pytest.raises(ocellus.OcellusError):
+        ocellus.ParticleFilter(np.zeros((0, 2)))

@@ -212,6 +212,18 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
         self.proposed = true;
     }
 
+    /// [`Self::propose`] with the proposal applied by the caller, to the whole cloud at once:
+    /// `proposal(particles, increments)` moves the particles in place and writes each one's
+    /// `ln p(x | x') - ln q(x | x', z)` into `increments` (zeroed: 0 for the bootstrap
+    /// filter). For proposals written over arrays (numpy, a GPU); then
+    /// [`Self::weigh_proposed_with`] completes the step.
+    pub fn propose_with(&mut self, proposal: impl FnOnce(&mut [S], &mut [f64])) {
+        self.increments.clear();
+        self.increments.resize(self.particles.len(), 0.0);
+        proposal(&mut self.particles, &mut self.increments);
+        self.proposed = true;
+    }
+
     /// The second half of [`Self::step`]: weighs the particles moved by [`Self::propose`]
     /// by the observation `z`, normalizes and resamples. An error when nothing was proposed
     /// since the last step.
@@ -490,5 +502,30 @@ mod tests {
         assert!(
             ParticleFilter::new(FilterConfig { resample_below: f64::NAN, ..Default::default() }, vec![0.0]).is_err()
         );
+    }
+
+    #[test]
+    fn a_proposal_written_over_the_cloud_weighs_as_the_hand_computation() {
+        let cfg = FilterConfig { resample_below: 0.0, ..FilterConfig::default() };
+        let mut f = ParticleFilter::new(cfg, vec![0.0f64, 1.0, 2.0, 3.0]).unwrap();
+        f.propose_with(|p, inc| {
+            p.iter_mut().for_each(|x| *x += 0.5);
+            inc[3] = -1.0;
+        });
+        // Observation 2 with unit Gaussian noise.
+        f.weigh_proposed_with(|p, out| {
+            p.iter().zip(out.iter_mut()).for_each(|(x, l)| *l = -0.5 * (x - 2.0) * (x - 2.0))
+        })
+        .unwrap();
+        assert_eq!(f.particles(), &[0.5, 1.5, 2.5, 3.5]);
+        let raw: Vec<f64> = [0.5f64, 1.5, 2.5, 3.5]
+            .iter()
+            .enumerate()
+            .map(|(i, x)| (-0.5 * (x - 2.0) * (x - 2.0) - if i == 3 { 1.0 } else { 0.0 }).exp())
+            .collect();
+        let s: f64 = raw.iter().sum();
+        for (w, r) in f.weights().iter().zip(&raw) {
+            assert!((w - r / s).abs() < 1e-12, "{w} vs {}", r / s);
+        }
     }
 }
