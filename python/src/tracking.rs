@@ -27,19 +27,24 @@ fn weights(w: Vec<f64>) -> PyResult<Vec<f64>> {
     Ok(w.into_iter().map(|v| v / s).collect())
 }
 
+/// The resampler named `scheme`.
+fn resampler(scheme: &str) -> PyResult<Resampler> {
+    Ok(match scheme {
+        "systematic" => Resampler::Systematic,
+        "stratified" => Resampler::Stratified,
+        "multinomial" => Resampler::Multinomial,
+        "residual" => Resampler::Residual,
+        other => return Err(err(format!("scheme {other:?}: systematic, stratified, multinomial or residual"))),
+    })
+}
+
 /// `resample(weights, scheme="systematic", seed=1)`: parent indices (increasing) of
 /// `len(weights)` offspring (SPEC 7.1): "systematic" (the seed's Algorithm 2), "stratified",
 /// "multinomial" or "residual". The weights are normalized first.
 #[pyfunction]
 #[pyo3(signature = (weights, scheme = "systematic", seed = 1))]
 fn resample(py: Python<'_>, weights: Vec<f64>, scheme: &str, seed: u64) -> PyResult<Vec<usize>> {
-    let r = match scheme {
-        "systematic" => Resampler::Systematic,
-        "stratified" => Resampler::Stratified,
-        "multinomial" => Resampler::Multinomial,
-        "residual" => Resampler::Residual,
-        other => return Err(err(format!("scheme {other:?}: systematic, stratified, multinomial or residual"))),
-    };
+    let r = resampler(scheme)?;
     let w = self::weights(weights)?;
     let mut out = Vec::with_capacity(w.len());
     py.detach(|| r.resample(&w, &mut SplitMix64::new(seed), &mut out)).map_err(err)?;
@@ -109,13 +114,7 @@ impl ParticleFilter {
         if !(0.0..=1.0).contains(&resample_below) {
             return Err(err(format!("resample_below {resample_below} is outside [0, 1]")));
         }
-        let resampler = match scheme {
-            "systematic" => Resampler::Systematic,
-            "stratified" => Resampler::Stratified,
-            "multinomial" => Resampler::Multinomial,
-            "residual" => Resampler::Residual,
-            other => return Err(err(format!("scheme {other:?}: systematic, stratified, multinomial or residual"))),
-        };
+        let resampler = resampler(scheme)?;
         let cfg = ocellus_estimation::particle_filter::FilterConfig { resample_below, resampler, seed };
         let filter = ocellus_estimation::particle_filter::ParticleFilter::new(cfg, s).map_err(err)?;
         Ok(Self { filter, dim })
