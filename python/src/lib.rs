@@ -151,6 +151,9 @@ fn config_from(preset: &str, overrides: Option<&Bound<'_, PyDict>>) -> PyResult<
 #[pyclass(module = "ocellus._ocellus")]
 struct SaliencyEngine {
     engine: Engine,
+    /// The engine's own frame buffer, which `input` shows to Python without a copy (8-bit
+    /// RGB, the frame size; never resized, so the memory stays where the view points).
+    frame: RgbImage,
 }
 
 #[pymethods]
@@ -162,7 +165,35 @@ impl SaliencyEngine {
     fn new(width: usize, height: usize, preset: &str, config: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         check_frame_size(width, height)?;
         let cfg = config_from(preset, config)?;
-        Ok(Self { engine: Engine::new(cfg, width, height).map_err(err)? })
+        let engine = Engine::new(cfg, width, height).map_err(err)?;
+        Ok(Self { engine, frame: RgbImage::U8(Plane::new(width, height)) })
+    }
+
+    /// The engine's frame buffer as a writable uint8 H x W x 3 numpy array that shares the
+    /// engine's memory: fill it in place (e.g. `cv2.imdecode` or a camera driver writing into
+    /// it, or `buf[:] = frame`) and call `process_input()`; no pixel is copied on the way in.
+    /// The view keeps the engine alive.
+    #[getter]
+    fn input<'py>(this: Bound<'py, Self>) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+        // A mutable borrow: Python writes through the pointer this view is made from.
+        let mut engine = this.borrow_mut();
+        let RgbImage::U8(plane) = &mut engine.frame else {
+            return Err(err("the frame buffer is not 8-bit"));
+        };
+        let (w, h) = plane.size();
+        let bytes = plane.as_contiguous_mut().ok_or_else(|| err("the frame buffer is not contiguous"))?;
+        let view = numpy::ndarray::ArrayViewMut3::from_shape((h, w, 3), bytes.as_flattened_mut()).map_err(err)?;
+        // SAFETY: `frame` is never resized or replaced, so the memory stays valid while the
+        // engine lives, and the engine (`container`) is kept alive by the array's base.
+        let container = this.clone().into_any();
+        Ok(unsafe { numpy::PyArray3::borrow_from_array(&view, container) })
+    }
+
+    /// The saliency map of the frame in `input` (filled in place). The GIL stays held while
+    /// it runs, so no Python code writes the buffer while the engine reads it.
+    fn process_input<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f32>>> {
+        let map = self.engine.process(&self.frame).map_err(err)?.clone();
+        to_numpy(py, map)
     }
 
     /// The saliency map of `image` at the map level (1/16 of the frame per side for the

@@ -51,6 +51,24 @@ def test_outputs_own_the_rust_buffer(photo):
     assert m.flags.c_contiguous and m.flags.writeable
 
 
+def test_the_engines_input_buffer_is_shared_not_copied(photo):
+    h, w, _ = photo.shape
+    engine = ocellus.SaliencyEngine(w, h)
+    buf = engine.input
+    assert buf.shape == (h, w, 3) and buf.dtype == np.uint8 and buf.flags.writeable
+    # The same memory every time: what Python writes there is what the engine reads.
+    assert np.shares_memory(buf, engine.input)
+    buf[:] = photo
+    m = engine.process_input()
+    assert np.array_equal(m, ocellus.saliency(photo))
+    buf[:, : w // 2] = 0
+    assert not np.array_equal(engine.process_input(), m)
+    # The view keeps its engine alive.
+    view = ocellus.SaliencyEngine(w, h).input
+    view[:] = 7
+    assert view.base is not None and int(view.sum()) == 7 * h * w * 3
+
+
 def test_grey_float_and_strided_inputs(photo):
     ref = ocellus.saliency(photo)
     # A strided view is read through its strides: the same map as its contiguous copy.
