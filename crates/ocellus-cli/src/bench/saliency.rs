@@ -126,13 +126,28 @@ fn gpu_figures(cfg: &SaliencyConfig, frames: &[RgbImage], n: usize, figures: &mu
     for batch in [8usize, 64] {
         let group: Vec<RgbImage> = frames.iter().cycle().take(batch).cloned().collect();
         e.process_batch(&group, &mut out)?;
-        let mut per_frame: Vec<f64> = (0..(n / batch).max(1))
-            .map(|_| {
-                let s = Instant::now();
-                e.process_batch(&group, &mut out).map(|_| s.elapsed().as_secs_f64() * 1e3 / batch as f64)
-            })
-            .collect::<std::result::Result<_, _>>()?;
+        let (mut per_frame, mut phases): (Vec<f64>, [Vec<f64>; 3]) = (Vec::new(), Default::default());
+        for _ in 0..(n / batch).max(1) {
+            let s = Instant::now();
+            e.process_batch(&group, &mut out)?;
+            per_frame.push(s.elapsed().as_secs_f64() * 1e3 / batch as f64);
+            #[cfg(feature = "gpu")]
+            if let Some(t) = e.gpu_timings() {
+                for (k, d) in [t.upload, t.gpu, t.readback].iter().enumerate() {
+                    phases[k].push(d.as_secs_f64() * 1e3 / batch as f64);
+                }
+            }
+        }
         figures[format!("ms_per_frame_batch_{batch}")] = json!(median(&mut per_frame));
+        if !phases[0].is_empty() {
+            // Per frame: the GPU phase alone is the batch's time without upload and readback.
+            let m: serde_json::Map<String, serde_json::Value> = ["upload", "gpu", "readback"]
+                .iter()
+                .zip(phases.iter_mut())
+                .map(|(name, v)| (name.to_string(), json!(median(v))))
+                .collect();
+            figures[format!("gpu_phase_ms_per_frame_batch_{batch}")] = serde_json::Value::Object(m);
+        }
     }
     Ok(())
 }
