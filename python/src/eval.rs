@@ -3,6 +3,7 @@
 
 use crate::{err, plane_f64};
 use ocellus_eval::metrics;
+use ocellus_image::Plane;
 use pyo3::prelude::*;
 
 /// Fixations from an N x 2 array (or sequence) of (x, y).
@@ -22,25 +23,33 @@ fn fixations(obj: &Bound<'_, PyAny>) -> PyResult<Vec<(usize, usize)>> {
         .collect()
 }
 
+/// A density metric of two maps of one size, the GIL released.
+fn density_metric(
+    py: Python<'_>,
+    saliency: &Bound<'_, PyAny>,
+    density: &Bound<'_, PyAny>,
+    metric: fn(&Plane<f64>, &Plane<f64>) -> ocellus_eval::Result<f64>,
+) -> PyResult<f64> {
+    let (s, d) = (plane_f64(saliency, "saliency")?, plane_f64(density, "density")?);
+    py.detach(|| metric(&s, &d)).map_err(err)
+}
+
 /// `cc(saliency, density)`: Pearson's linear correlation coefficient of two maps of one size.
 #[pyfunction]
 fn cc(py: Python<'_>, saliency: &Bound<'_, PyAny>, density: &Bound<'_, PyAny>) -> PyResult<f64> {
-    let (s, d) = (plane_f64(saliency, "saliency")?, plane_f64(density, "density")?);
-    py.detach(|| metrics::cc(&s, &d)).map_err(err)
+    density_metric(py, saliency, density, metrics::cc)
 }
 
 /// `sim(saliency, density)`: histogram intersection of the two maps as distributions.
 #[pyfunction]
 fn sim(py: Python<'_>, saliency: &Bound<'_, PyAny>, density: &Bound<'_, PyAny>) -> PyResult<f64> {
-    let (s, d) = (plane_f64(saliency, "saliency")?, plane_f64(density, "density")?);
-    py.detach(|| metrics::sim(&s, &d)).map_err(err)
+    density_metric(py, saliency, density, metrics::sim)
 }
 
 /// `kl(saliency, density)`: KL divergence of the density from the saliency map, in nats.
 #[pyfunction]
 fn kl(py: Python<'_>, saliency: &Bound<'_, PyAny>, density: &Bound<'_, PyAny>) -> PyResult<f64> {
-    let (s, d) = (plane_f64(saliency, "saliency")?, plane_f64(density, "density")?);
-    py.detach(|| metrics::kl(&s, &d)).map_err(err)
+    density_metric(py, saliency, density, metrics::kl)
 }
 
 /// `nss(saliency, fixations)`: normalized scanpath saliency.

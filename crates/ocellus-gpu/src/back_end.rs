@@ -4,6 +4,7 @@
 
 use crate::front_end::Pass;
 use crate::{GpuContext, GpuError, Result};
+use ocellus_image::preserving::preserving_factors;
 use wgpu::util::DeviceExt;
 
 /// Which front-end plane a sub-feature reads.
@@ -99,27 +100,6 @@ pub(crate) struct BackEnd {
 /// Offsets (floats) of a used level's planes in the front end's plane buffer: intensity,
 /// red-green, blue-yellow, first Gabor plane (the angles follow, one plane apart).
 pub(crate) type LevelOffsets = [u64; 4];
-
-/// The energy-preserving factors of a 1D kernel on an axis of `n` pixels:
-/// `sum(k) / sum(taps of k inside the axis)` (the sums in the CPU filter's order).
-fn preserving_factors(k: &[f32], n: usize) -> Vec<f32> {
-    let total: f32 = k.iter().sum();
-    let hw = (k.len() - 1) / 2;
-    (0..n)
-        .map(|i| {
-            let inside: f32 = k
-                .iter()
-                .enumerate()
-                .filter(|(t, _)| {
-                    let q = i as isize + *t as isize - hw as isize;
-                    q >= 0 && q < n as isize
-                })
-                .map(|(_, &v)| v)
-                .sum();
-            total / inside
-        })
-        .collect()
-}
 
 impl BackEnd {
     /// Builds the passes of `spec` reading `planes` (levels at `used` with `offsets`).
@@ -388,22 +368,5 @@ impl BackEnd {
             }
         }
         Ok(Self { passes, maps, n_maps, saliency_at, map_size: spec.map_size })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn preserving_factors_renormalize_the_truncated_kernel() {
-        let k = [1.0, 2.0, 4.0, 2.0, 1.0];
-        let f = preserving_factors(&k, 6);
-        // At the first pixel the taps -2 and -1 fall outside: 10 / 7.
-        assert!((f[0] - 10.0 / 7.0).abs() < 1e-6);
-        assert!((f[1] - 10.0 / 9.0).abs() < 1e-6);
-        assert_eq!(f[2], 1.0);
-        assert_eq!(f[3], 1.0);
-        assert!((f[5] - 10.0 / 7.0).abs() < 1e-6);
     }
 }

@@ -41,6 +41,15 @@ pub(crate) struct Pass {
     pub(crate) groups: [u32; 3],
 }
 
+impl Pass {
+    /// Records the dispatch into `pass`.
+    fn record(&self, pass: &mut wgpu::ComputePass) {
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.dispatch_workgroups(self.groups[0], self.groups[1], self.groups[2]);
+    }
+}
+
 /// What the front end computes, in plain terms; the saliency engine (`ocellus-attention`,
 /// feature `gpu`) fills it from its configuration.
 #[derive(Clone, Debug)]
@@ -443,11 +452,6 @@ impl GpuFrontEnd {
         self.run(frame, Some(&mut maps), levels)
     }
 
-    /// Number of maps [`Self::process_maps`] writes (0 without the map-level stages).
-    pub fn map_count(&self) -> usize {
-        self.back.as_ref().map_or(0, |b| b.n_maps)
-    }
-
     /// Uploads `frame`, runs the front end (and the back end when `maps` is given), and reads
     /// back what is asked.
     fn run(
@@ -456,34 +460,17 @@ impl GpuFrontEnd {
         maps: Option<&mut dyn Iterator<Item = &mut Plane<f32>>>,
         levels: Option<LevelsOut>,
     ) -> Result<()> {
-        if frame.size() != (self.width, self.height) {
-            return Err(GpuError::InvalidInput(format!(
-                "frame is {}x{}, the GPU front end was built for {}x{}",
-                frame.width(),
-                frame.height(),
-                self.width,
-                self.height
-            )));
-        }
         let t0 = Instant::now();
-        let row_bytes = 3 * self.width;
-        for (y, row) in frame.rows().enumerate() {
-            self.bytes[y * row_bytes..(y + 1) * row_bytes].copy_from_slice(row.as_flattened());
-        }
+        self.pack(frame)?;
         let (device, queue) = (&self.ctx.device, &self.ctx.queue);
         queue.write_buffer(&self.input, 0, &self.bytes);
         let t1 = Instant::now();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("saliency") });
-        let back = match (&self.back, maps.is_some()) {
-            (Some(b), true) => Some(b),
-            _ => None,
-        };
+        let back = self.back.as_ref().filter(|_| maps.is_some());
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
             for p in self.passes.iter().chain(back.into_iter().flat_map(|b| &b.passes)) {
-                pass.set_pipeline(&p.pipeline);
-                pass.set_bind_group(0, &p.bind_group, &[]);
-                pass.dispatch_workgroups(p.groups[0], p.groups[1], p.groups[2]);
+                p.record(&mut pass);
             }
         }
         if let Some(b) = back {
@@ -499,16 +486,9 @@ impl GpuFrontEnd {
         }
         let end = if levels.is_some() { self.maps_bytes + self.planes_bytes } else { self.maps_bytes };
         queue.submit([encoder.finish()]);
-        let t2;
+        self.wait_for_read(&self.staging, end)?;
+        let t2 = Instant::now();
         if end > 0 {
-            let (tx, rx) = mpsc::channel();
-            self.staging.slice(..end).map_async(wgpu::MapMode::Read, move |r| {
-                // The receiver waits below; a send can only fail if it is gone.
-                let _ = tx.send(r);
-            });
-            device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
-            rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
-            t2 = Instant::now();
             {
                 let view = self.staging.get_mapped_range(..end).map_err(|e| GpuError::Readback(e.to_string()))?;
                 let data: &[f32] = bytemuck::cast_slice(&view);
@@ -524,11 +504,45 @@ impl GpuFrontEnd {
                 }
             }
             self.staging.unmap();
-        } else {
-            device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
-            t2 = Instant::now();
         }
         self.timings = FrontEndTimings { upload: t1 - t0, gpu: t2 - t1, readback: t2.elapsed() };
+        Ok(())
+    }
+
+    /// Packs `frame`'s bytes into the upload buffer, after checking its size.
+    fn pack(&mut self, frame: &Plane<[u8; 3]>) -> Result<()> {
+        if frame.size() != (self.width, self.height) {
+            return Err(GpuError::InvalidInput(format!(
+                "frame is {}x{}, the GPU engine was built for {}x{}",
+                frame.width(),
+                frame.height(),
+                self.width,
+                self.height
+            )));
+        }
+        let row_bytes = 3 * self.width;
+        for (y, row) in frame.rows().enumerate() {
+            self.bytes[y * row_bytes..(y + 1) * row_bytes].copy_from_slice(row.as_flattened());
+        }
+        Ok(())
+    }
+
+    /// Waits until the submitted work is done and the first `end` bytes of `buffer` are
+    /// mapped for reading (nothing is mapped when `end` is 0).
+    fn wait_for_read(&self, buffer: &wgpu::Buffer, end: u64) -> Result<()> {
+        let readback = |e: &dyn std::fmt::Display| GpuError::Readback(e.to_string());
+        let rx = (end > 0).then(|| {
+            let (tx, rx) = mpsc::channel();
+            buffer.slice(..end).map_async(wgpu::MapMode::Read, move |r| {
+                // The receiver waits below; a send can only fail if it is gone.
+                let _ = tx.send(r);
+            });
+            rx
+        });
+        self.ctx.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| readback(&e))?;
+        if let Some(rx) = rx {
+            rx.recv().map_err(|e| readback(&e))?.map_err(|e| readback(&e))?;
+        }
         Ok(())
     }
 

@@ -8,6 +8,28 @@ use crate::filter::{
 use crate::simd::Madd;
 use crate::{dispatch_kernel, Backend, ImageError, Plane, Result};
 
+/// The energy-preserving factor of each pixel of an axis of `n` pixels for the 1D kernel `k`
+/// (odd length, centred): `sum(k) / sum(taps of k that fall inside the axis)`, 1 away from
+/// the borders. [`PreservingFilter`] scales each pass by it; a GPU port reads the same table.
+pub fn preserving_factors(k: &[f32], n: usize) -> Vec<f32> {
+    let total: f32 = k.iter().sum();
+    let hw = (k.len().max(1) - 1) / 2;
+    (0..n)
+        .map(|i| {
+            let inside: f32 = k
+                .iter()
+                .enumerate()
+                .filter(|(t, _)| {
+                    let p = i as isize + *t as isize - hw as isize;
+                    p >= 0 && p < n as isize
+                })
+                .map(|(_, &v)| v)
+                .sum();
+            total / inside
+        })
+        .collect()
+}
+
 /// Separable correlation with a zero border whose result at each pixel is rescaled by
 /// `sum(kernel) / sum(kernel taps inside the image)`, per axis: the kernel is truncated
 /// at the border and renormalized, so a border does not lower the response
@@ -41,20 +63,11 @@ impl PreservingFilter {
             return Err(ImageError::InvalidParameter("energy-preserving kernel must have a positive sum".into()));
         }
         let hw = (k.len() - 1) / 2;
-        let valid_sum = |i: usize, n: usize| -> f32 {
-            k.iter()
-                .enumerate()
-                .filter(|(t, _)| {
-                    let p = i as isize + *t as isize - hw as isize;
-                    p >= 0 && p < n as isize
-                })
-                .map(|(_, &v)| v)
-                .sum()
-        };
-        let fx = (0..width).map(|x| total / valid_sum(x, width)).collect();
+        let fx = preserving_factors(k, width);
+        let fy = preserving_factors(k, height);
         let rows = (0..height)
             .map(|y| {
-                let f = total / valid_sum(y, height);
+                let f = fy[y];
                 let mut r = Vec::new();
                 vertical_taps(y, height, k, Border::Zero, &mut r);
                 r.iter_mut().for_each(|(_, w)| *w *= f);
@@ -224,3 +237,19 @@ fn preserving_generic<M: Madd>(
 dispatch_kernel!(fn preserving_kernel => preserving_generic(
     k: &[f32], sym: Symmetry, fx: &[f32], rows: &[Vec<(usize, f32)>], padded: &mut [f32], tmp: &mut Plane<f32>, src: &Plane<f32>, dst: &mut Plane<f32>
 ));
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn preserving_factors_renormalize_the_truncated_kernel() {
+        let k = [1.0, 2.0, 4.0, 2.0, 1.0];
+        let f = preserving_factors(&k, 6);
+        // At the first pixel the taps -2 and -1 fall outside: 10 / 7.
+        assert!((f[0] - 10.0 / 7.0).abs() < 1e-6);
+        assert!((f[1] - 10.0 / 9.0).abs() < 1e-6);
+        assert_eq!(f[2], 1.0);
+        assert_eq!(f[3], 1.0);
+        assert!((f[5] - 10.0 / 7.0).abs() < 1e-6);
+    }
+}

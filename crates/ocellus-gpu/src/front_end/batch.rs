@@ -9,7 +9,6 @@
 use super::{FrontEndTimings, GpuFrontEnd};
 use crate::{GpuError, Result};
 use ocellus_image::Plane;
-use std::sync::mpsc;
 use std::time::Instant;
 
 /// The unpack pass's pieces, to bind it to each slot of a batch's input.
@@ -106,24 +105,15 @@ impl GpuFrontEnd {
         };
         let ((map_w, map_h), sal_at) = (back.map_size, back.saliency_at);
         if let Some(f) = frames.iter().find(|f| f.size() != (self.width, self.height)) {
-            return Err(GpuError::InvalidInput(format!(
-                "frame is {}x{}, the GPU engine was built for {}x{}",
-                f.width(),
-                f.height(),
-                self.width,
-                self.height
-            )));
+            return self.pack(f);
         }
         if frames.is_empty() {
             return Ok(());
         }
         let t0 = Instant::now();
-        let row_bytes = 3 * self.width;
         let stride = self.batch_for(frames.len())?.stride;
         for (b, frame) in frames.iter().enumerate() {
-            for (y, row) in frame.rows().enumerate() {
-                self.bytes[y * row_bytes..(y + 1) * row_bytes].copy_from_slice(row.as_flattened());
-            }
+            self.pack(frame)?;
             if let Some(batch) = &self.batch {
                 self.ctx.queue.write_buffer(&batch.input, b as u64 * stride, &self.bytes);
             }
@@ -144,9 +134,7 @@ impl GpuFrontEnd {
                 pass.dispatch_workgroups(g[0], g[1], g[2]);
                 // The first pass of the single-frame list is its own unpack.
                 for p in self.passes.iter().skip(1).chain(&back.passes) {
-                    pass.set_pipeline(&p.pipeline);
-                    pass.set_bind_group(0, &p.bind_group, &[]);
-                    pass.dispatch_workgroups(p.groups[0], p.groups[1], p.groups[2]);
+                    p.record(&mut pass);
                 }
             }
             encoder.copy_buffer_to_buffer(
@@ -159,13 +147,7 @@ impl GpuFrontEnd {
         }
         self.ctx.queue.submit([encoder.finish()]);
         let end = map_bytes * frames.len() as u64;
-        let (tx, rx) = mpsc::channel();
-        batch.staging.slice(..end).map_async(wgpu::MapMode::Read, move |r| {
-            // The receiver waits below; a send can only fail if it is gone.
-            let _ = tx.send(r);
-        });
-        self.ctx.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| GpuError::Readback(e.to_string()))?;
-        rx.recv().map_err(|e| GpuError::Readback(e.to_string()))?.map_err(|e| GpuError::Readback(e.to_string()))?;
+        self.wait_for_read(&batch.staging, end)?;
         let t2 = Instant::now();
         {
             let view = batch.staging.get_mapped_range(..end).map_err(|e| GpuError::Readback(e.to_string()))?;
