@@ -3,7 +3,7 @@
 # The build needs a Rust toolchain and a C compiler; video input (ocellus attend/surprise and
 # their tests) runs the ffmpeg program as a subprocess; the GPU backend needs a Vulkan loader
 # and, without a GPU, a software Vulkan driver; the Python package's tests need python3 with
-# venv.
+# venv; the report's browser test opens the generated page in headless Chromium.
 set -euo pipefail
 
 need=()
@@ -17,6 +17,8 @@ ldconfig -p 2>/dev/null | grep -q 'libvulkan\.so\.1' || need+=(libvulkan1)
 # The Python package's tests run in a virtual environment (python3 -m venv, with pip).
 command -v python3 >/dev/null 2>&1 || need+=(python3)
 python3 -m venv --help >/dev/null 2>&1 || need+=(python3-venv)
+# The report's browser test (crates/ocellus-cli/tests/report_browser.rs) runs headless Chromium.
+command -v chromium >/dev/null 2>&1 || need+=(chromium)
 
 if [ ${#need[@]} -gt 0 ]; then
   if [ "$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi
