@@ -25,6 +25,7 @@ mod output_files;
 mod plan_cmd;
 mod plot;
 mod ranges;
+mod report_cmd;
 mod retina_cmd;
 mod saliency_cmd;
 mod stereo_cmd;
@@ -51,9 +52,12 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Run the main capabilities end to end on built-in data: saliency maps and overlays, then
-    /// attention over a generated sequence.
+    /// Run every capability end to end on built-in and generated data and write one HTML
+    /// report (ocellus-demo/index.html).
     Demo(demo::DemoArgs),
+    /// Build the HTML report (DIR/index.html) of the outputs in a folder: a section per
+    /// subfolder.
+    Report(report_cmd::ReportArgs),
     /// Compute bottom-up saliency maps (Itti-Koch-Niebur) for images or folders of images.
     Saliency(saliency_cmd::SaliencyArgs),
     /// Score saliency maps against human fixations (CC, SIM, KL, NSS, AUCs, IG; MIT benchmark definitions).
@@ -118,8 +122,32 @@ fn main() {
         Ok(c) => c,
         Err(e) => e.exit(),
     };
-    let r: Result<()> = match cli.command {
+    let r = dispatch(cli.command);
+    let r = r.and_then(|()| Ok(out::flush_stdout()?));
+    if let Err(e) = r {
+        let stdout = e.chain().find_map(|c| c.downcast_ref::<out::StdoutError>());
+        if stdout.is_some_and(out::StdoutError::is_broken_pipe) {
+            // The reader took what it wanted (`| head -1`): end quietly, with the status a
+            // shell gives a program stopped by SIGPIPE.
+            std::process::exit(141);
+        }
+        errln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+/// Runs one command line, `args` without the program name (`["stereo", "l.png", ...]`),
+/// as `main` would: the demo runs its parts through the very commands it shows.
+pub fn run_args(args: &[String]) -> Result<()> {
+    let argv = std::iter::once("ocellus".to_string()).chain(args.iter().cloned());
+    let matches = command().try_get_matches_from(argv)?;
+    dispatch(Cli::from_arg_matches(&matches)?.command)
+}
+
+fn dispatch(command: Command) -> Result<()> {
+    match command {
         Command::Demo(a) => demo::run(a),
+        Command::Report(a) => report_cmd::run(a),
         Command::Saliency(a) => saliency_cmd::run(a),
         Command::Bench(a) => bench::run(a),
         Command::Eval(a) => eval::run(a),
@@ -135,17 +163,6 @@ fn main() {
         Command::Logpolar(a) => logpolar_cmd::run(a),
         Command::Track(a) => track_cmd::run(a),
         Command::Retina(a) => retina_cmd::run(a),
-    };
-    let r = r.and_then(|()| Ok(out::flush_stdout()?));
-    if let Err(e) = r {
-        let stdout = e.chain().find_map(|c| c.downcast_ref::<out::StdoutError>());
-        if stdout.is_some_and(out::StdoutError::is_broken_pipe) {
-            // The reader took what it wanted (`| head -1`): end quietly, with the status a
-            // shell gives a program stopped by SIGPIPE.
-            std::process::exit(141);
-        }
-        errln!("error: {e:#}");
-        std::process::exit(1);
     }
 }
 

@@ -29,9 +29,36 @@ impl StdoutError {
     }
 }
 
-/// Writes formatted text to standard output (used by [`outln!`] and [`out!`]).
+thread_local! {
+    /// Where [`write_stdout`] writes while [`captured`] runs on this thread.
+    static CAPTURE: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Writes formatted text to standard output (used by [`outln!`] and [`out!`]), or into the
+/// buffer of a [`captured`] call on this thread.
 pub fn write_stdout(args: fmt::Arguments<'_>) -> Result<(), StdoutError> {
+    let taken = CAPTURE.with(|c| match c.borrow_mut().as_mut() {
+        Some(buf) => {
+            // Writing to a String cannot fail.
+            let _ = fmt::Write::write_fmt(buf, args);
+            true
+        }
+        None => false,
+    });
+    if taken {
+        return Ok(());
+    }
     std::io::stdout().lock().write_fmt(args).map_err(StdoutError)
+}
+
+/// Runs `f` with what it writes through [`outln!`] and [`out!`] on this thread collected
+/// instead of printed (the demo keeps each command's report for its page); returns `f`'s
+/// result and the text. Nested calls collect into the innermost.
+pub fn captured<T>(f: impl FnOnce() -> T) -> (T, String) {
+    let outer = CAPTURE.with(|c| c.borrow_mut().replace(String::new()));
+    let r = f();
+    let text = CAPTURE.with(|c| std::mem::replace(&mut *c.borrow_mut(), outer)).unwrap_or_default();
+    (r, text)
 }
 
 /// Flushes standard output: the last bytes of a block-buffered stdout fail only here.

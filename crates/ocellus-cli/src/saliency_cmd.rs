@@ -53,17 +53,14 @@ pub struct SaliencyResult {
     pub map_size: (usize, usize),
     /// Most salient location in input pixels (x, y; integer centres), centre of the winning map cell.
     pub peak_px: [f64; 2],
-    /// Files written.
-    pub files: Vec<PathBuf>,
 }
 
-fn write_map(out: &Path, name: &str, map: &Plane<f32>, files: &mut Vec<PathBuf>) -> Result<()> {
+fn write_map(out: &Path, name: &str, map: &Plane<f32>) -> Result<()> {
     let (_, mx) = map.min_max();
     let png = out.join(format!("{name}.png"));
     ocellus_io::write_png(&png, &convert::to_grey8(map, 0.0, if mx > 0.0 { mx } else { 1.0 }))?;
     let npy = out.join(format!("{name}.npy"));
     ocellus_io::npy::write_plane(&npy, map)?;
-    files.extend([png, npy]);
     Ok(())
 }
 
@@ -83,25 +80,23 @@ pub fn process_one(
     let Some(e) = engine.as_mut() else { bail!("engine missing") };
     e.process(&img).with_context(|| format!("{}", path.display()))?;
     let stem = inputs::stem(path);
-    let mut files = Vec::new();
-    write_map(out, &format!("{stem}.saliency"), e.saliency(), &mut files)?;
+    write_map(out, &format!("{stem}.saliency"), e.saliency())?;
     let mut full = Plane::default();
     e.saliency_full_size(&mut full)?;
     let ov = out.join(format!("{stem}.overlay.png"));
     ocellus_io::write_png(&ov, &ocellus_image::colormap::overlay(&img.to_u8(), &full))?;
-    files.push(ov);
     if conspicuity {
         let maps: Vec<(String, Plane<f32>)> =
             e.conspicuity_maps().map(|(l, m)| (l.replace(':', "-"), m.clone())).collect();
         for (label, m) in maps {
-            write_map(out, &format!("{stem}.conspicuity.{label}"), &m, &mut files)?;
+            write_map(out, &format!("{stem}.conspicuity.{label}"), &m)?;
         }
     }
     let s = e.saliency();
     let Some(peak) = ocellus_image::location::peak(s, (w, h)) else {
         bail!("{}: the saliency map is empty", path.display())
     };
-    Ok(SaliencyResult { map_size: s.size(), peak_px: peak.pixel, files })
+    Ok(SaliencyResult { map_size: s.size(), peak_px: peak.pixel })
 }
 
 /// Runs the subcommand.

@@ -2,7 +2,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
 mod common;
-use common::{ocellus, tmpdir};
+use common::{ocellus, run, tmpdir};
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -112,13 +112,26 @@ fn bench_names_the_backend_it_ran_and_times_resampling() {
 }
 
 #[test]
-fn demo_runs_on_built_in_images() {
-    let out = tmpdir("demo");
-    let o = ocellus().arg("demo").arg("--out").arg(&out).output().unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(out.join("ace2009/astronaut.overlay.png").is_file());
-    assert!(out.join("stb/rocket.saliency.npy").is_file());
-    assert!(out.join("logpolar/chelsea.cortex.png").is_file() && out.join("logpolar/chelsea.inverse.png").is_file());
+fn report_builds_a_page_from_a_folder_of_outputs() {
+    let out = tmpdir("report");
+    // Two subcommands' outputs side by side.
+    run(ocellus().args(["logpolar"]).arg(ocellus_testdata::asset("chelsea.png")).arg("--out").arg(out.join("lp")));
+    run(ocellus().args(["plan", "corridor", "--out"]).arg(out.join("plan")));
+    let o = run(ocellus().arg("report").arg(&out).args(["--title", "two <outputs>"]));
+    assert!(o.contains("2 sections"), "{o}");
+    let page = std::fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(page.contains("<title>two &lt;outputs&gt;</title>"));
+    for src in ["lp/cortex.png", "lp/inverse.png", "plan/angles.png"] {
+        assert!(page.contains(&format!("src=\"{src}\"")), "{src}");
+    }
+    assert!(page.contains("href=\"plan/steps.csv\"") && page.contains("href=\"lp/logpolar.json\""));
+    // A folder with nothing to show, and no folder, are errors.
+    let empty = tmpdir("report-empty");
+    let e = ocellus().arg("report").arg(&empty).output().unwrap();
+    assert_eq!(e.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&e.stderr).contains("nothing to report"));
+    let e = ocellus().arg("report").arg(empty.join("nowhere")).output().unwrap();
+    assert!(String::from_utf8_lossy(&e.stderr).contains("is not a folder"));
 }
 
 #[test]

@@ -24,7 +24,7 @@ a { color: var(--accent); }
 nav ol { columns: 2 16rem; padding-left: 1.25rem; }
 pre, code { font: 13px/1.45 ui-monospace, SFMono-Regular, Menlo, Consolas, monospace; }
 pre { background: var(--code); padding: 0.6rem 0.8rem; overflow-x: auto; border-radius: 6px; }
-.scroll { overflow-x: auto; }
+.scroll { overflow-x: auto; margin-bottom: 1rem; }
 table { border-collapse: collapse; min-width: 60%; }
 th, td { text-align: left; padding: 0.3rem 0.8rem 0.3rem 0; border-bottom: 1px solid var(--line); vertical-align: top; }
 th { color: var(--muted); font-weight: 600; }
@@ -40,8 +40,13 @@ details summary { cursor: pointer; color: var(--muted); }
 @media (max-width: 600px) { main { padding: 0.5rem 0.75rem 3rem; } h1 { font-size: 1.5rem; } .grid { grid-template-columns: 1fr; } }
 "#;
 
-/// Counts and marks pictures that did not load, once the page has loaded.
+/// Counts and marks pictures that did not load, once the page has loaded, and counts script
+/// errors.
 const SCRIPT: &str = r#"
+window.addEventListener("error", function () {
+  var n = Number(document.body.getAttribute("data-script-errors") || "0") + 1;
+  document.body.setAttribute("data-script-errors", String(n));
+});
 window.addEventListener("load", function () {
   var broken = 0;
   document.querySelectorAll("img").forEach(function (img) {
