@@ -121,7 +121,7 @@ pub fn run(a: DemoArgs) -> Result<()> {
     let layout = Layout {
         title: "ocellus: what it does and how well".into(),
         intro: format!(
-            "Every capability of ocellus run end to end on built-in and generated data by `ocellus demo{}` \
+            "Every capability of ocellus run end to end on built-in and generated data by \"ocellus demo{}\" \
              ({:.0} s on this machine). Each section gives the commands that reproduce it in this folder, \
              its key figures beside the seed's or an anchor's, pictures and the data files.",
             if a.quick { " --quick" } else { "" },
