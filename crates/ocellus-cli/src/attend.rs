@@ -53,6 +53,11 @@ pub struct AttendArgs {
     /// overlays); 0: one per core. The results do not depend on it. Range: 0..=256.
     #[arg(long, default_value_t = 0, value_parser = ranges::within(0usize, 256))]
     pub workers: usize,
+    /// Also log the run for the Rerun viewer to this .rrd file: frames, saliency, surprise
+    /// and inhibition maps, fixations, the scanpath, chaos degree and surprise maximum per
+    /// frame (needs ocellus built with the `rerun` feature).
+    #[arg(long)]
+    pub rrd: Option<PathBuf>,
 }
 
 /// Options shared by the commands that run the stream engine.
@@ -217,6 +222,37 @@ impl Outputs {
     }
 }
 
+/// Frame `r` in the Rerun log: the frame, its maps, where attention is, the recent scanpath
+/// (before this frame's saccade) and the context values.
+fn log_frame(rec: &crate::rrd::Recorder, frame: &RgbImage, r: &StreamFrame, recent: &[Fixation]) -> Result<()> {
+    rec.at(r.frame, None);
+    match frame {
+        RgbImage::U8(p) => rec.frame_rgb("frame", p)?,
+        other => rec.frame_rgb("frame", &other.to_u8())?,
+    }
+    rec.map("maps/saliency", r.saliency)?;
+    rec.map("maps/surprise_bits", r.surprise)?;
+    rec.map("maps/inhibition", r.inhibition)?;
+    if let Some(f) = r.fixation {
+        // Salient places green, surprising ones red.
+        let colour = match f.reason {
+            Reason::Salient => [40, 220, 80, 255],
+            Reason::Surprising => [255, 60, 40, 255],
+        };
+        rec.points_2d("frame/fixation", &[[f64::from(f.x), f64::from(f.y)]], 8.0, colour)?;
+        let mut path: Vec<[f64; 2]> = recent.iter().map(|p| [f64::from(p.x), f64::from(p.y)]).collect();
+        if f.saccade {
+            path.push([f64::from(f.x), f64::from(f.y)]);
+        }
+        rec.strip_2d("frame/scanpath", &path, [255, 220, 0, 255])?;
+    }
+    if let Some(c) = r.chaos {
+        rec.scalar("context/chaos_bits", c)?;
+    }
+    rec.scalar("context/surprise_max_bits", f64::from(r.surprise.min_max().1))?;
+    Ok(())
+}
+
 /// The overlay image: [frame with fixations | saliency] over [surprise | inhibition], each
 /// panel at half the frame size (even sizes, for video).
 fn composite(r: &RenderJob) -> Result<Plane<[u8; 3]>> {
@@ -287,6 +323,7 @@ pub fn run(a: AttendArgs) -> Result<()> {
 /// keep the memory fixed whatever the length of the stream.
 pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
     let cfg = a.stream.config(a.deg_per_px)?;
+    let rrd = crate::rrd::open(a.rrd.as_deref(), "ocellus_attend")?;
     let pan_tilt = a.pan_tilt.as_deref().map(frames::read_pan_tilt).transpose()?;
     for d in [a.out.clone(), a.out.join("overlays")] {
         crate::inputs::check_out_dir(&d, std::slice::from_ref(&a.input))?;
@@ -327,6 +364,9 @@ pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
                     None => (0.0, 0.0),
                 };
                 let r = e.process_maps(maps, pan, tilt)?;
+                if let Some(rec) = &rrd {
+                    log_frame(rec, &frame, &r, &out.recent)?;
+                }
                 let job = out.record(frame, &r, draw)?;
                 if job.is_some_and(|j| jobs.send(j).is_err()) {
                     bail!("the overlay writer stopped");
@@ -336,10 +376,15 @@ pub fn run_quiet(a: AttendArgs) -> Result<(usize, usize, Vec<String>)> {
         },
     );
     let wrote_video = video.is_some();
+    let logged = rrd.map_or(Ok(()), crate::rrd::Recorder::finish);
     let rendered = rendered.and_then(|()| video.take().map_or(Ok(()), |v| Ok(v.finish()?)));
     // Whatever happened, what was processed is written out.
     let saccades = out.saccades;
-    let written = out.finish(threshold, wrote_video && rendered.is_ok())?;
+    let mut written = out.finish(threshold, wrote_video && rendered.is_ok())?;
+    logged?;
+    if let Some(p) = &a.rrd {
+        written.push(p.display().to_string());
+    }
     // A writer that failed first makes the stream stop with "writer stopped": its own error
     // is the one to report.
     rendered?;

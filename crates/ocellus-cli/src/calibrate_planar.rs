@@ -56,7 +56,11 @@ pub struct ChessboardArgs {
     square: String,
     #[command(flatten)]
     model: ModelArgs,
-    /// Output folder: camera.toml, calibration.json, per_view_error.png, corners/NAME.png.
+    /// Output folder: camera.toml, calibration.json, per_view_error.png, corners/NAME.png;
+    /// for `ocellus triangulate`, board.csv (the inner corners on the board, mm, z = 0) and
+    /// per view views/NAME.json (the projection matrix from the board's millimetres to
+    /// undistorted pixels) and views/NAME.csv (the corners found, undistorted, in board.csv's
+    /// order).
     #[arg(long, default_value = "ocellus-calibration")]
     out: PathBuf,
 }
@@ -180,8 +184,47 @@ pub fn run_chessboard(a: ChessboardArgs) -> Result<()> {
         }
         ocellus_io::write_png(a.out.join("corners").join(format!("{}.png", stem(f))), &img)?;
     }
+    write_views(&a.out, &used, &views, &cal)?;
     let names: Vec<String> = used.iter().map(|f| f.display().to_string()).collect();
     report(&a.out, &cal, size, &names, "chessboard", square)
+}
+
+/// board.csv and, per view, its projection matrix (board mm to undistorted pixels) and its
+/// corners undistorted: what `ocellus triangulate` reads to rebuild the board from two views.
+fn write_views(out: &Path, files: &[PathBuf], views: &[PlanarView], cal: &PlanarCalibration) -> Result<()> {
+    use std::io::Write;
+    let dir = out.join("views");
+    crate::output_files::create_dir(&dir)?;
+    if let Some(v) = views.first() {
+        let mut f = crate::output_files::create_file(&out.join("board.csv"))?;
+        writeln!(f, "x_mm,y_mm,z_mm")?;
+        for p in &v.object {
+            writeln!(f, "{},{},0", p[0], p[1])?;
+        }
+        f.flush()?;
+    }
+    for ((file, view), pose) in files.iter().zip(views).zip(&cal.poses) {
+        let camera = ocellus_geometry::camera::PinholeCamera { k: cal.intrinsics, r: pose.r, t: pose.t };
+        let p = camera.projection_matrix();
+        let doc = json!({
+            "view": file.display().to_string(),
+            "projection_matrix": (0..3).map(|i| (0..4).map(|j| p[(i, j)]).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        });
+        let name = dir.join(format!("{}.json", stem(file)));
+        std::fs::write(&name, serde_json::to_string_pretty(&doc)?)
+            .with_context(|| format!("cannot write {}", name.display()))?;
+        let mut f = crate::output_files::create_file(&dir.join(format!("{}.csv", stem(file))))?;
+        writeln!(f, "u,v")?;
+        for q in &view.image {
+            let (u, v) = cal
+                .distortion
+                .undistort_pixel(&cal.intrinsics, q[0], q[1])
+                .with_context(|| format!("{}: a corner cannot be undistorted", file.display()))?;
+            writeln!(f, "{u:.4},{v:.4}")?;
+        }
+        f.flush()?;
+    }
+    Ok(())
 }
 
 /// Runs `calibrate planar`.
@@ -298,5 +341,8 @@ fn report(
         sd[8]
     );
     outln!("wrote {}/camera.toml, calibration.json, per_view_error.png", out.display());
+    if source == "chessboard" {
+        outln!("wrote {}/board.csv and views/NAME.json, views/NAME.csv for triangulate", out.display());
+    }
     Ok(())
 }

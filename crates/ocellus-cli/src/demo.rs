@@ -155,7 +155,7 @@ fn run_parts(quick: bool) -> Result<Vec<String>> {
         ("eval", "How well it predicts where people look", "The saliency map scored against human fixation density maps of MIT1003 images with the MIT benchmark's definitions (CC, SIM, KL), beside the centre-prior baseline. The repository ships four of the images; the README's table has the 100-image figures.", eval),
         ("attention", "Attention over time: surprise, context and saccades", "A generated 30-frame sequence over a real photo in which an object appears at frame 15: Bayesian surprise, the context chaos degree, winner-take-all with habituation and inhibition of return on an ego-sphere (SPEC 2.1, 2.2, 3).", attention),
         ("plan", "Where to look next: information-based view planning", "The seed's corridor experiment (SPEC 2.6): a robot drives past four landmarks and picks a pan angle every 0.5 m by top-down information gain; when a person appears at step 5 the chaos degree jumps and bottom-up surprise wins.", plan),
-        ("calibration", "Where things are: calibration and undistortion", "Twelve generated views of a 9x6 chessboard over real photographs through a camera with lens distortion; Zhang's planar calibration refined by Levenberg-Marquardt (SPEC 5.3), then the views undistorted.", calibration),
+        ("calibration", "Where things are: calibration, undistortion, triangulation", "Twelve generated views of a 9x6 chessboard over real photographs through a camera with lens distortion; Zhang's planar calibration refined by Levenberg-Marquardt (SPEC 5.3), then the views undistorted, and the board rebuilt in 3D by triangulating its corners from two calibrated views (SPEC 5.5).", calibration),
         ("stereo", "Stereo depth: semi-global matching", "The Middlebury 2014 motorcycle pair (downsampled 4x): census costs aggregated along 8 paths, sub-pixel disparity, left-right check (SPEC 5.6), scored against the ground truth, with depth and a point cloud from the calibration.", stereo),
         ("odometry", "How it moved: ground-facing visual odometry", "A generated floor sequence seen by a downward camera (SPEC 6): the seed's block matching and Kalman filter, and the robust mode fused with wheel encoders, each scored against the true trajectory.", odometry),
         ("logpolar", "Foveal vision: the log-polar retina", "The anti-aliased log-polar image of a photo about a gaze point and its inverse (SPEC 4.1), rotation and scale between two images by log-polar phase correlation, and vergence at the fovea of a stereo pair (SPEC 4.3).", logpolar),
@@ -302,6 +302,27 @@ fn calibration(p: &mut Part, _quick: bool) -> Result<()> {
         fmt(number_after(&c, "k1 "), 4, ""),
         &fmt(truth.as_deref().and_then(|t| number_after(t, "k1 = ")), 4, " (truth)").unwrap_or_default(),
     );
+    // Two views rebuild the board: their corners (undistorted) side by side, as `paste -d,`
+    // would join them, triangulated with the two views' projection matrices.
+    let views = ["view_00", "view_06"];
+    let matches = "calibration/matches.csv";
+    let join = format!(
+        "paste -d, calibration/calib/views/{}.csv calibration/calib/views/{}.csv > {matches}",
+        views[0], views[1]
+    );
+    paste_csv(&views.map(|v| format!("calibration/calib/views/{v}.csv")), Path::new(matches))?;
+    p.section.commands.push(join.clone());
+    p.section.log.push_str(&format!("$ {join}\n"));
+    let t = p.run(&format!(
+        "triangulate --camera calibration/calib/views/{}.json --camera calibration/calib/views/{}.json {matches} \
+         --truth calibration/calib/board.csv --out calibration/board_points.csv",
+        views[0], views[1]
+    ))?;
+    p.figure(
+        "board corners triangulated from 2 views, RMS 3D error",
+        fmt(number_after(&t, "against the truth: "), 3, " mm"),
+        "squares of 25 mm",
+    );
     p.picture("calibration/boards/view_00.png", "a generated view");
     p.picture("calibration/undistorted/view_00.png", "the same view undistorted");
     p.picture("calibration/calib/per_view_error.png", "reprojection error per view");
@@ -309,8 +330,24 @@ fn calibration(p: &mut Part, _quick: bool) -> Result<()> {
         "calibration/calib/camera.toml",
         "calibration/calib/calibration.json",
         "calibration/boards/camera_truth.toml",
+        "calibration/board_points.csv",
     ]);
     Ok(())
+}
+
+/// Joins CSV files line by line with commas, as `paste -d,` does (equal line counts).
+fn paste_csv(inputs: &[String], out: &Path) -> Result<()> {
+    let texts: Vec<String> = inputs
+        .iter()
+        .map(|f| std::fs::read_to_string(f).with_context(|| format!("cannot read {f}")))
+        .collect::<Result<_>>()?;
+    let lines: Vec<Vec<&str>> = texts.iter().map(|t| t.lines().collect()).collect();
+    if lines.windows(2).any(|w| w[0].len() != w[1].len()) {
+        bail!("{} do not have equal line counts", inputs.join(" and "));
+    }
+    let n = lines.first().map_or(0, Vec::len);
+    let joined: String = (0..n).map(|i| lines.iter().map(|l| l[i]).collect::<Vec<_>>().join(",") + "\n").collect();
+    std::fs::write(out, joined).with_context(|| format!("cannot write {}", out.display()))
 }
 
 fn stereo(p: &mut Part, _quick: bool) -> Result<()> {

@@ -60,6 +60,17 @@ pub struct OdometryArgs {
     /// trajectory_vision.tum), trajectory.png, flow_NNNNN.png for a few frames.
     #[arg(long, default_value = "ocellus-odometry")]
     out: PathBuf,
+    /// Ground truth to show beside the estimate: a TUM trajectory of the rotation centre
+    /// (e.g. groundtruth.tum of `generate ground`); drawn in trajectory.png and, with --rrd,
+    /// logged with the drift per frame.
+    #[arg(long)]
+    truth: Option<PathBuf>,
+    /// Also log the run for the Rerun viewer to this .rrd file: the undistorted frames, the
+    /// flow vectors (drawn 5x long), the estimated and true poses per frame and both whole
+    /// trajectories, and the drift per frame with --truth (needs ocellus built with the
+    /// `rerun` feature).
+    #[arg(long)]
+    rrd: Option<PathBuf>,
 }
 
 /// Estimator choice.
@@ -126,6 +137,12 @@ pub fn run(a: OdometryArgs) -> Result<()> {
     if !(a.encoder_rate_hz > 0.0 && a.rate_hz > 0.0) {
         bail!("--rate-hz and --encoder-rate-hz must be positive");
     }
+    let truth = a.truth.as_deref().map(ocellus_io::tum::read).transpose()?;
+    let rrd = crate::rrd::open(a.rrd.as_deref(), "ocellus_odometry")?;
+    if let Some(rec) = &rrd {
+        rec.static_axes("world", false)?;
+    }
+    let mut truth_path = (0.0f64, None::<[f64; 2]>);
     let mut fusion = Fusion::new(FusionConfig { encoder_rate_hz: a.encoder_rate_hz, ..Default::default() }, mount);
     let mut vision_poses = Vec::new();
     crate::inputs::check_out_dir(&a.out, std::slice::from_ref(input))?;
@@ -165,24 +182,40 @@ pub fn run(a: OdometryArgs) -> Result<()> {
         } else {
             poses.push(TumPose::planar(t, p.x, p.y, p.theta));
         }
+        if let Some(rec) = &rrd {
+            let est = poses.last().map_or([0.0; 3], |p| p.position);
+            let truth_now = truth.as_deref().and_then(|g| pose_at(g, t, 0.5 / a.rate_hz));
+            log_step(rec, k, t, &grey, &step.flows, est, truth_now, &mut truth_path)?;
+        }
         Ok(())
     })?;
+    if let Some(rec) = rrd {
+        let floor = |p: &TumPose| [p.position[0], -p.position[1], 0.0];
+        rec.static_strip_3d("world/estimate/path", &poses.iter().map(floor).collect::<Vec<_>>(), [230, 50, 40, 255])?;
+        if let Some(g) = &truth {
+            rec.static_strip_3d("world/truth/path", &g.iter().map(floor).collect::<Vec<_>>(), [40, 40, 40, 255])?;
+        }
+        rec.finish()?;
+    }
     let secs = t0.elapsed().as_secs_f64();
     ocellus_io::tum::write(a.out.join("trajectory.tum"), &poses)?;
+    let mut runs: Vec<(&str, &[TumPose], RGBColor)> = Vec::new();
+    if let Some(g) = &truth {
+        runs.push(("ground truth", g, RGBColor(30, 30, 30)));
+    }
     if readings.is_some() {
         ocellus_io::tum::write(a.out.join("trajectory_vision.tum"), &vision_poses)?;
-        plot_trajectories(
-            &a.out.join("trajectory.png"),
-            &[("fused", &poses, RGBColor(200, 40, 40)), ("vision", &vision_poses, RGBColor(40, 90, 200))],
-        )?;
+        runs.push(("fused", &poses, RGBColor(200, 40, 40)));
+        runs.push(("vision", &vision_poses, RGBColor(40, 90, 200)));
         outln!(
             "encoders: {} frames with slipping wheels ignored, {} bridged by the wheels",
             fusion.rejected,
             fusion.bridged
         );
     } else {
-        plot_trajectories(&a.out.join("trajectory.png"), &[("estimate", &poses, RGBColor(200, 40, 40))])?;
+        runs.push(("estimate", &poses, RGBColor(200, 40, 40)));
     }
+    plot_trajectories(&a.out.join("trajectory.png"), &runs)?;
     let last = poses.last().context("no frames")?;
     outln!(
         "{n} frames in {secs:.2} s ({:.0} fps, decoding included); {failures} without texture; final pose ({:.4}, {:.4}) m, {:.2} deg",
@@ -192,10 +225,54 @@ pub fn run(a: OdometryArgs) -> Result<()> {
         last.yaw().to_degrees()
     );
     outln!("wrote trajectory.tum, trajectory.png and flow overlays in {}", a.out.display());
+    if let Some(p) = &a.rrd {
+        outln!("wrote {}", p.display());
+    }
     Ok(())
 }
 
 /// The frame with its flow vectors drawn 5x longer (green) from their group centres (red).
+/// The pose of `poses` (in time order) within `tol` seconds of `t`.
+fn pose_at(poses: &[TumPose], t: f64, tol: f64) -> Option<[f64; 3]> {
+    let i = poses.partition_point(|p| p.time_s < t - tol);
+    poses.get(i).filter(|p| (p.time_s - t).abs() <= tol).map(|p| p.position)
+}
+
+/// One frame in the Rerun log: the frame with its flow, the poses on the floor (x right, y
+/// forward, as trajectory.png draws them), and the drift (distance between the estimate and
+/// the truth over the true path so far, percent) once the path is 1 cm long.
+#[allow(clippy::too_many_arguments)]
+fn log_step(
+    rec: &crate::rrd::Recorder,
+    k: usize,
+    t: f64,
+    grey: &Plane<u8>,
+    flows: &[ocellus_odometry::sad_flow::FlowPoint],
+    est: [f64; 3],
+    truth: Option<[f64; 3]>,
+    path: &mut (f64, Option<[f64; 2]>),
+) -> Result<()> {
+    rec.at(k, Some(t));
+    rec.frame_grey("camera", grey)?;
+    let (w, h) = grey.size();
+    let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
+    let origins: Vec<[f64; 2]> = flows.iter().map(|f| [f.u + cx, f.v + cy]).collect();
+    let vectors: Vec<[f64; 2]> = flows.iter().map(|f| [5.0 * f.du, 5.0 * f.dv]).collect();
+    rec.arrows_2d("camera/flow_x5", &origins, &vectors, [0, 230, 0, 255])?;
+    rec.points_3d("world/estimate", &[[est[0], -est[1], 0.0]], 0.004, [230, 50, 40, 255])?;
+    if let Some(g) = truth {
+        rec.points_3d("world/truth", &[[g[0], -g[1], 0.0]], 0.004, [40, 40, 40, 255])?;
+        if let Some(last) = path.1 {
+            path.0 += (g[0] - last[0]).hypot(g[1] - last[1]);
+        }
+        path.1 = Some([g[0], g[1]]);
+        if path.0 >= 0.01 {
+            rec.scalar("error/drift_percent", 100.0 * (est[0] - g[0]).hypot(est[1] - g[1]) / path.0)?;
+        }
+    }
+    Ok(())
+}
+
 fn write_flow(path: &Path, grey: &Plane<u8>, flows: &[ocellus_odometry::sad_flow::FlowPoint]) -> Result<()> {
     let (w, h) = grey.size();
     let mut img = grey.map(|v| [v, v, v]);

@@ -76,6 +76,12 @@ pub struct TrackArgs {
     /// Write no overlay PNGs (the mp4 still, when ffmpeg is there).
     #[arg(long)]
     no_overlays: bool,
+    /// Also log the run for the Rerun viewer to this .rrd file: frames, up to 1000 particles
+    /// (in the image and in 3D), the estimate (circle and centre), the truth with --truth,
+    /// and per frame the ESS, the colour score and, with --truth, the 3D and image-centre
+    /// errors (needs ocellus built with the `rerun` feature).
+    #[arg(long)]
+    rrd: Option<PathBuf>,
     /// Output folder: track.csv, overlays/frame_NNNNN.png (particles in yellow, the
     /// estimated circle in green, red when lost), overlays.mp4 (with ffmpeg), error.png (with
     /// --truth).
@@ -213,6 +219,10 @@ pub fn run(a: TrackArgs) -> Result<()> {
     let mut estimates = Vec::new();
     let mut first_size: Option<(usize, usize)> = None;
     let pinhole = PinholeCamera { k: cam.intrinsics, r: nalgebra::Matrix3::identity(), t: nalgebra::Vector3::zeros() };
+    let rrd = crate::rrd::open(a.rrd.as_deref(), "ocellus_track")?;
+    if let Some(rec) = &rrd {
+        rec.static_axes("world", true)?;
+    }
     let t0 = std::time::Instant::now();
     let n = for_each_frame(input, None, |k, frame| {
         let f = frame.to_u8();
@@ -231,6 +241,9 @@ pub fn run(a: TrackArgs) -> Result<()> {
         let Some(tr) = tracker.as_mut() else { bail!("no tracker") };
         let e = tr.process(&f)?;
         write_row(&mut csv, &e, a.fps)?;
+        if let Some(rec) = &rrd {
+            log_frame(rec, &f, &e, tr, truth.as_deref().and_then(|t| t.get(k)), radius_m, a.fps)?;
+        }
         let over = overlay(&f, &e, tr);
         if !a.no_overlays {
             ocellus_io::write_png(a.out.join("overlays").join(format!("frame_{k:05}.png")), &over)?;
@@ -253,6 +266,9 @@ pub fn run(a: TrackArgs) -> Result<()> {
     if let Some(v) = video {
         v.finish()?;
     }
+    if let Some(rec) = rrd {
+        rec.finish()?;
+    }
     let secs = t0.elapsed().as_secs_f64();
     let lost = estimates.iter().filter(|e| e.lost).count();
     outln!(
@@ -262,6 +278,9 @@ pub fn run(a: TrackArgs) -> Result<()> {
         a.boost,
         a.out.join("track.csv").display()
     );
+    if let Some(p) = &a.rrd {
+        outln!("wrote {}", p.display());
+    }
     if let Some(truth) = truth {
         let est: Vec<EstimateFrame> = estimates.iter().map(ocellus_sim::ball_tracking::estimate_frame).collect();
         if truth.len() != est.len() {
@@ -297,6 +316,50 @@ fn write_row(w: &mut impl Write, e: &TrackEstimate, fps: f64) -> Result<()> {
         u8::from(e.lost),
         e.detections
     )?;
+    Ok(())
+}
+
+/// One frame in the Rerun log (see `--rrd`); 3D in the camera frame (x right, y down, z
+/// forward), metres.
+fn log_frame(
+    rec: &crate::rrd::Recorder,
+    f: &Plane<[u8; 3]>,
+    e: &TrackEstimate,
+    tr: &BallTracker,
+    truth: Option<&TruthFrame>,
+    radius_m: f64,
+    fps: f64,
+) -> Result<()> {
+    rec.at(e.frame, Some(e.frame as f64 / fps));
+    rec.frame_rgb("frame", f)?;
+    let ps = tr.particles();
+    let step = ps.len().div_ceil(1000).max(1);
+    let shown: Vec<_> = ps.iter().step_by(step).collect();
+    let centres: Vec<[f64; 2]> = shown.iter().filter_map(|p| tr.model().circle(p)).map(|c| [c.x, c.y]).collect();
+    rec.points_2d("frame/particles", &centres, 1.0, [255, 230, 0, 160])?;
+    rec.points_3d("world/particles", &shown.iter().map(|p| p.position).collect::<Vec<_>>(), 0.003, [255, 200, 0, 160])?;
+    if let Some(c) = e.circle {
+        let colour = if e.lost { [230, 30, 30, 255] } else { [40, 230, 60, 255] };
+        rec.circles_2d("frame/estimate", &[[c.x, c.y, c.r]], colour)?;
+    }
+    if let Some(p) = e.position {
+        rec.points_3d("world/estimate", &[p], radius_m as f32, [40, 230, 60, 255])?;
+    }
+    rec.scalar("filter/ess", e.ess)?;
+    rec.scalar("filter/score", e.score)?;
+    if let Some(t) = truth {
+        if let Some(c) = t.circle {
+            rec.circles_2d("frame/truth", &[c], [60, 120, 255, 255])?;
+            if let Some(ec) = e.circle {
+                rec.scalar("error/centre_px", (ec.x - c[0]).hypot(ec.y - c[1]))?;
+            }
+        }
+        rec.points_3d("world/truth", &[t.position], radius_m as f32, [60, 120, 255, 255])?;
+        if let Some(p) = e.position {
+            let d = (0..3).map(|i| (p[i] - t.position[i]).powi(2)).sum::<f64>().sqrt();
+            rec.scalar("error/3d_m", d)?;
+        }
+    }
     Ok(())
 }
 

@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use nalgebra::{Matrix3x4, Vector4};
+use nalgebra::{Matrix3x4, Vector3, Vector4};
 use ocellus_geometry::triangulate::{n_view, two_view_seed};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -18,6 +18,10 @@ pub struct TriangulateArgs {
     /// Use the seed's 4x3 least squares (two cameras only) instead of the homogeneous form.
     #[arg(long)]
     pub seed_form: bool,
+    /// The true points, `X,Y,Z` per line in the order of the matches (e.g. board.csv of
+    /// `calibrate chessboard`): prints the RMS 3D error (world units).
+    #[arg(long)]
+    pub truth: Option<PathBuf>,
     /// Output CSV: X, Y, Z, in front of every camera (1/0), RMS reprojection error (pixels).
     #[arg(long, default_value = "points.csv")]
     pub out: PathBuf,
@@ -57,6 +61,18 @@ pub fn run(a: TriangulateArgs) -> Result<()> {
     let ps: Vec<Matrix3x4<f64>> = a.cameras.iter().map(|c| read_camera(c)).collect::<Result<_>>()?;
     ocellus_geometry::triangulate::check_rig(&ps).context("the --camera files cannot triangulate")?;
     let rows = ocellus_io::csv::read_rows(&a.matches, 2 * ps.len(), "a pixel 'u,v' per camera")?;
+    let truth = a.truth.as_deref().map(|t| ocellus_io::csv::read_rows(t, 3, "'X,Y,Z'")).transpose()?;
+    if let Some(t) = &truth {
+        if t.len() != rows.len() {
+            bail!(
+                "{} has {} points for {} matches",
+                a.truth.as_deref().unwrap_or(Path::new("")).display(),
+                t.len(),
+                rows.len()
+            );
+        }
+    }
+    let mut points = Vec::with_capacity(rows.len());
     let mut out = crate::output_files::create_file(&a.out)?;
     writeln!(out, "x,y,z,in_front,rms_px")?;
     let (mut n, mut behind) = (0usize, 0usize);
@@ -80,6 +96,7 @@ pub fn run(a: TriangulateArgs) -> Result<()> {
             .sum();
         let rms = (sq / ps.len() as f64).sqrt();
         writeln!(out, "{},{},{},{},{rms:.6}", t.point.x, t.point.y, t.point.z, u8::from(t.in_front))?;
+        points.push(t.point);
         n += 1;
         behind += usize::from(!t.in_front);
     }
@@ -92,6 +109,11 @@ pub fn run(a: TriangulateArgs) -> Result<()> {
     }
     if behind > 0 {
         errln!("warning: {behind} of {n} points lie behind a camera (in_front = 0 in {})", a.out.display());
+    }
+    if let Some(t) = truth {
+        let t: Vec<Vector3<f64>> = t.iter().map(|r| Vector3::new(r[0], r[1], r[2])).collect();
+        let e = ocellus_geometry::triangulate::rms_distance(&points, &t)?;
+        outln!("RMS 3D error against the truth: {e:.4} (world units), over {n} points");
     }
     Ok(())
 }

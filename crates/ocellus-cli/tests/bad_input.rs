@@ -234,6 +234,8 @@ const CASES: &[Case] = &[
     c("triangulate --camera {D}/p0.json --camera {D}/not_json.json {D}/matches.csv --out {O}/p.csv", Error(&["not_json.json", "json"])),
     c("triangulate --camera {D}/p0.json --camera {D}/p_short.json {D}/matches.csv --out {O}/p.csv", Error(&["p_short.json", "3 rows"])),
     c("triangulate --camera {D}/p0.json --camera {D}/p1.json {D}/missing.csv --out {O}/p.csv", Error(&["missing.csv"])),
+    c("triangulate --camera {D}/p0.json --camera {D}/p1.json {D}/matches.csv --truth {D}/truth_3.csv --out {O}/p.csv", Error(&["3 points for 2 matches"])),
+    c("triangulate --camera {D}/p0.json --camera {D}/p1.json {D}/matches.csv --truth {D}/pts_extra.csv --out {O}/p.csv", Error(&["pts_extra.csv", "got 6"])),
     // ---- stereo
     c("stereo {D}/img.png {D}/img.png --focal-px 0 --baseline 1 --out {O}", Usage(&["--focal-px", "range"])),
     c("stereo {D}/img.png {D}/img.png --focal-px 500 --baseline -1 --out {O}", Usage(&["--baseline", "range"])),
@@ -361,6 +363,7 @@ fn fixtures(d: &Path) {
     w("pts_planar.csv", rows(&p, &planar).as_bytes());
     w("pts_nan.csv", rows(&p, &pts).replacen("0.25", "nan", 1).as_bytes());
     w("pts_extra.csv", b"1,2,3,4,5,6\n1,2,3,4,5,6\n");
+    w("truth_3.csv", b"X,Y,Z\n0,0,1\n0,1,1\n1,0,1\n");
     w("pts_short.csv", b"1,2,3\n1,2,3,4,5\n");
     let affine = nalgebra::Matrix3x4::new(800.0, 10.0, 5.0, 320.0, -4.0, 790.0, 12.0, 240.0, 0.0, 0.0, 0.0, 1.0);
     w("pts_affine.csv", rows(&affine, &pts).as_bytes());

@@ -55,6 +55,29 @@ fn calibrate_chessboard_recovers_the_rendering_camera_and_undistort_straightens_
     assert!(report["rms_px"].as_f64().unwrap() < 0.2, "{}", report["rms_px"]);
     assert!(report["std_dev"]["fx"].as_f64().unwrap() > 0.0);
 
+    // Two calibrated views rebuild the board: their undistorted corners side by side,
+    // triangulated with their projection matrices, land on the board's own grid (25 mm).
+    let corners = |v: &str| std::fs::read_to_string(cal.join("views").join(format!("{v}.csv"))).unwrap();
+    let (a, b) = (corners("view_00"), corners("view_05"));
+    let matches: String = a.lines().zip(b.lines()).map(|(x, y)| format!("{x},{y}\n")).collect();
+    std::fs::write(dir.join("matches.csv"), matches).unwrap();
+    let board = std::fs::read_to_string(cal.join("board.csv")).unwrap();
+    assert_eq!(board.lines().count(), 55, "a header and 9 x 6 corners");
+    assert!(board.lines().nth(2).unwrap().starts_with("25,0,0"), "{board}");
+    let t = run(ocellus()
+        .arg("triangulate")
+        .arg("--camera")
+        .arg(cal.join("views/view_00.json"))
+        .arg("--camera")
+        .arg(cal.join("views/view_05.json"))
+        .arg(dir.join("matches.csv"))
+        .arg("--truth")
+        .arg(cal.join("board.csv"))
+        .arg("--out")
+        .arg(dir.join("board_points.csv")));
+    let rms: f64 = t.split("against the truth: ").nth(1).unwrap().split_whitespace().next().unwrap().parse().unwrap();
+    assert!(rms < 0.5, "board rebuilt within {rms} mm: {t}");
+
     // The exact corners through `calibrate planar` give the camera exactly.
     let planar = dir.join("planar");
     run(ocellus().args(["calibrate", "planar"]).arg(views.join("corners_truth.csv")).arg("--out").arg(&planar));

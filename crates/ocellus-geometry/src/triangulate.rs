@@ -208,6 +208,16 @@ fn inverse_iteration(m: &Matrix4<f64>) -> Option<Vector4<f64>> {
     None
 }
 
+/// The RMS distance between matched points (`a[i]` with `b[i]`), in their units: how far
+/// triangulated points lie from the true ones. An error for empty or unequal lists.
+pub fn rms_distance(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> Result<f64> {
+    if a.is_empty() || a.len() != b.len() {
+        return Err(GeometryError::Invalid(format!("{} points against {} true points", a.len(), b.len())));
+    }
+    let sq: f64 = a.iter().zip(b).map(|(p, q)| (p - q).norm_squared()).sum();
+    Ok((sq / a.len() as f64).sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -313,5 +323,14 @@ mod tests {
         assert!(two_view_seed(&ps[0], [f64::NAN, 0.0], &ps[1], [0.0, 0.0]).is_err());
         // The same camera twice: parallel rays.
         assert!(two_view_seed(&ps[0], [100.0, 100.0], &ps[0], [100.0, 100.0]).is_err());
+    }
+
+    #[test]
+    fn rms_distance_is_the_root_mean_square_of_the_distances() {
+        let a = [Vector3::new(0.0, 0.0, 0.0), Vector3::new(1.0, 1.0, 1.0)];
+        let b = [Vector3::new(3.0, 4.0, 0.0), Vector3::new(1.0, 1.0, 1.0)];
+        // Distances 5 and 0: sqrt(25 / 2).
+        assert!((rms_distance(&a, &b).unwrap() - 12.5f64.sqrt()).abs() < 1e-12);
+        assert!(rms_distance(&a, &b[..1]).is_err() && rms_distance(&[], &[]).is_err());
     }
 }

@@ -135,7 +135,8 @@ impl BallWorldConfig {
         if !(self.focal_px.is_finite() && self.focal_px > 0.0) {
             return bad(format!("focal length {} px must be positive", self.focal_px));
         }
-        if self.full_occlusion_frames == 0 || self.full_occlusion_frames + 4 > self.frames {
+        let panel = matches!(self.occlusion, Occlusion::Full | Occlusion::Both);
+        if self.full_occlusion_frames == 0 || (panel && self.full_occlusion_frames + 4 > self.frames) {
             return bad(format!(
                 "{} frames of full occlusion do not fit {} frames (at least 1, and 4 frames to spare)",
                 self.full_occlusion_frames, self.frames
@@ -604,10 +605,14 @@ mod tests {
             BallWorldConfig { fps: f64::NAN, ..ok },
             BallWorldConfig { radius_m: 0.0, ..ok },
             BallWorldConfig { noise_sigma: -1.0, ..ok },
-            BallWorldConfig { full_occlusion_frames: 58, ..ok },
+            BallWorldConfig { occlusion: Occlusion::Full, full_occlusion_frames: 58, ..ok },
+            BallWorldConfig { occlusion: Occlusion::Both, frames: 13, ..ok },
+            BallWorldConfig { full_occlusion_frames: 0, ..ok },
         ] {
             assert!(BallWorld::new(cfg, &bg, &occ).is_err(), "{cfg:?}");
         }
+        // Without the panel a sequence may be shorter than its occlusion would be.
+        assert!(BallWorld::new(BallWorldConfig { frames: 8, ..ok }, &bg, &occ).is_ok());
         assert!(matches!(BallWorld::new(ok, &bg, &occ).unwrap().frame(60), Err(SynthError::NoSuchFrame { .. })));
     }
 }

@@ -106,6 +106,7 @@ fn attend_fps(video: &Path, out: &Path, overlays: bool, workers: usize, frames: 
         fps: 30,
         limit: None,
         workers,
+        rrd: None,
     };
     // "5" resets the peak resident set size of this process (Linux 4.0 and later).
     let _ = std::fs::write("/proc/self/clear_refs", "5");
