@@ -56,6 +56,17 @@ fn open_file(path: &Path, app: &'static str) -> Result<Recorder> {
     Ok(Recorder { rec })
 }
 
+/// An ocellus pixel position (centres at integers) in Rerun's frame (centres at half-integers).
+#[cfg(feature = "rerun")]
+fn frame_px(p: [f64; 2]) -> [f32; 2] {
+    [p[0] as f32 + 0.5, p[1] as f32 + 0.5]
+}
+
+#[cfg(feature = "rerun")]
+fn colour_of(c: Rgba) -> rerun::Color {
+    rerun::Color::from_unmultiplied_rgba(c[0], c[1], c[2], c[3])
+}
+
 #[cfg(feature = "rerun")]
 impl Recorder {
     /// Sets the time of what follows: frame `frame`, and `time_s` seconds when known.
@@ -118,23 +129,19 @@ impl Recorder {
 
     /// Points in the frame (ocellus pixel coordinates), radius in pixels.
     pub fn points_2d(&self, entity: &str, pts: &[[f64; 2]], radius_px: f32, colour: Rgba) -> Result<()> {
-        let p: Vec<[f32; 2]> = pts.iter().map(|p| [p[0] as f32 + 0.5, p[1] as f32 + 0.5]).collect();
+        let p: Vec<[f32; 2]> = pts.iter().map(|&p| frame_px(p)).collect();
         self.log(
             entity,
             &rerun::Points2D::new(p)
                 .with_radii([rerun::Radius::new_ui_points(radius_px)])
-                .with_colors([rerun::Color::from_unmultiplied_rgba(colour[0], colour[1], colour[2], colour[3])]),
+                .with_colors([colour_of(colour)]),
         )
     }
 
     /// A polyline in the frame (ocellus pixel coordinates).
     pub fn strip_2d(&self, entity: &str, pts: &[[f64; 2]], colour: Rgba) -> Result<()> {
-        let p: Vec<[f32; 2]> = pts.iter().map(|p| [p[0] as f32 + 0.5, p[1] as f32 + 0.5]).collect();
-        self.log(
-            entity,
-            &rerun::LineStrips2D::new([p])
-                .with_colors([rerun::Color::from_unmultiplied_rgba(colour[0], colour[1], colour[2], colour[3])]),
-        )
+        let p: Vec<[f32; 2]> = pts.iter().map(|&p| frame_px(p)).collect();
+        self.log(entity, &rerun::LineStrips2D::new([p]).with_colors([colour_of(colour)]))
     }
 
     /// Circles in the frame (ocellus pixel coordinates): `[x, y, r]`.
@@ -145,49 +152,31 @@ impl Recorder {
                 (0..=48)
                     .map(|i| {
                         let a = i as f64 / 48.0 * std::f64::consts::TAU;
-                        [(c[0] + c[2] * a.cos()) as f32 + 0.5, (c[1] + c[2] * a.sin()) as f32 + 0.5]
+                        frame_px([c[0] + c[2] * a.cos(), c[1] + c[2] * a.sin()])
                     })
                     .collect()
             })
             .collect();
-        self.log(
-            entity,
-            &rerun::LineStrips2D::new(strips)
-                .with_colors([rerun::Color::from_unmultiplied_rgba(colour[0], colour[1], colour[2], colour[3])]),
-        )
+        self.log(entity, &rerun::LineStrips2D::new(strips).with_colors([colour_of(colour)]))
     }
 
     /// Arrows in the frame from `origins` (ocellus pixel coordinates) along `vectors`, pixels.
     pub fn arrows_2d(&self, entity: &str, origins: &[[f64; 2]], vectors: &[[f64; 2]], colour: Rgba) -> Result<()> {
-        let o: Vec<[f32; 2]> = origins.iter().map(|p| [p[0] as f32 + 0.5, p[1] as f32 + 0.5]).collect();
+        let o: Vec<[f32; 2]> = origins.iter().map(|&p| frame_px(p)).collect();
         let v: Vec<[f32; 2]> = vectors.iter().map(|p| [p[0] as f32, p[1] as f32]).collect();
-        self.log(
-            entity,
-            &rerun::Arrows2D::from_vectors(v)
-                .with_origins(o)
-                .with_colors([rerun::Color::from_unmultiplied_rgba(colour[0], colour[1], colour[2], colour[3])]),
-        )
+        self.log(entity, &rerun::Arrows2D::from_vectors(v).with_origins(o).with_colors([colour_of(colour)]))
     }
 
     /// Points in 3D, metres; radius in metres.
     pub fn points_3d(&self, entity: &str, pts: &[[f64; 3]], radius_m: f32, colour: Rgba) -> Result<()> {
         let p: Vec<[f32; 3]> = pts.iter().map(|p| p.map(|v| v as f32)).collect();
-        self.log(
-            entity,
-            &rerun::Points3D::new(p)
-                .with_radii([radius_m])
-                .with_colors([rerun::Color::from_unmultiplied_rgba(colour[0], colour[1], colour[2], colour[3])]),
-        )
+        self.log(entity, &rerun::Points3D::new(p).with_radii([radius_m]).with_colors([colour_of(colour)]))
     }
 
     /// A polyline in 3D that holds for the whole recording (a full trajectory), metres.
     pub fn static_strip_3d(&self, entity: &str, pts: &[[f64; 3]], colour: Rgba) -> Result<()> {
         let p: Vec<[f32; 3]> = pts.iter().map(|p| p.map(|v| v as f32)).collect();
-        self.log_static(
-            entity,
-            &rerun::LineStrips3D::new([p])
-                .with_colors([rerun::Color::from_unmultiplied_rgba(colour[0], colour[1], colour[2], colour[3])]),
-        )
+        self.log_static(entity, &rerun::LineStrips3D::new([p]).with_colors([colour_of(colour)]))
     }
 
     /// The axes of `entity`'s 3D space, for the whole recording: the camera's (x right, y
