@@ -9,7 +9,7 @@ use ocellus_image::convert::RgbImage;
 use ocellus_image::Plane;
 use ocellus_io::tum::TumPose;
 use ocellus_io::y4m::Y4mWriter;
-use ocellus_synth::ground::{encoders, GroundConfig, GroundScene, GroundTexture};
+use ocellus_synth::ground::{encoders, GroundConfig, GroundScene, GroundTexture, FOCAL_PX};
 use std::io::Write;
 use std::path::PathBuf;
 
@@ -44,6 +44,23 @@ pub struct GroundArgs {
     /// Write one Y4M video instead of PNG frames.
     #[arg(long)]
     y4m: bool,
+    /// Render as a real camera sees: pixels integrating light over their area (2x2 samples),
+    /// lens distortion k1 = -0.05 (in camera.toml, so that odometry undistorts it) and 25 %
+    /// vignetting at the corners; --supersample, --k1 and --vignetting override each part.
+    #[arg(long)]
+    real_camera: bool,
+    /// Point samples per pixel side, averaged over the pixel's area (1: one point sample at
+    /// the pixel's centre). Default 1, or 2 with --real-camera. Range: 1..=8.
+    #[arg(long, value_parser = ranges::within(1usize, 8))]
+    supersample: Option<usize>,
+    /// Radial lens distortion k1 (normalized coordinates, focal 600 px), written to
+    /// camera.toml. Default 0, or -0.05 with --real-camera. Range: -0.5..=0.5.
+    #[arg(long, value_parser = ranges::within(-0.5f64, 0.5), allow_hyphen_values = true)]
+    k1: Option<f64>,
+    /// Brightness lost at the image corners (0.25: corners at 75 %). Default 0, or 0.25 with
+    /// --real-camera. Range: 0..=0.95.
+    #[arg(long, value_parser = ranges::within(0.0f32, 0.95))]
+    vignetting: Option<f32>,
     /// Output folder: frames/frame_NNNNN.png (or sequence.y4m), groundtruth.tum (the robot's
     /// rotation centre, metres), encoders.csv (30 Hz wheel odometry with slip events; the true
     /// slip per reading in encoder_slips.csv),
@@ -67,7 +84,14 @@ pub fn run(a: GroundArgs) -> Result<()> {
         TextureArg::Mosaic => GroundTexture::Mosaic,
     };
     let base = if a.hard { GroundConfig::hard(texture, a.seed) } else { GroundConfig::easy(texture, a.seed) };
-    let cfg = GroundConfig { frames: a.frames, ..base };
+    let base = if a.real_camera { base.real_camera() } else { base };
+    let cfg = GroundConfig {
+        frames: a.frames,
+        supersample: a.supersample.unwrap_or(base.supersample),
+        k1: a.k1.unwrap_or(base.k1),
+        vignetting: a.vignetting.unwrap_or(base.vignetting),
+        ..base
+    };
     let scene = GroundScene::new(cfg, textures()?)?;
     crate::output_files::create_dir(&a.out)?;
     let create =
@@ -108,14 +132,15 @@ pub fn run(a: GroundArgs) -> Result<()> {
     let mut cam = create("camera.toml")?;
     writeln!(
         cam,
-        "# The generated camera: 1 ground pixel = {} m.\nimage_size = [{}, {}]\nheight_m = 0.3\nmount_right_m = {}\nmount_forward_m = {}\n\n[intrinsics]\nfx = 600.0\nfy = 600.0\ncx = {}\ncy = {}\nskew = 0.0",
+        "# The generated camera: 1 ground pixel = {} m.\nimage_size = [{}, {}]\nheight_m = 0.3\nmount_right_m = {}\nmount_forward_m = {}\n\n[intrinsics]\nfx = {FOCAL_PX:.1}\nfy = {FOCAL_PX:.1}\ncx = {}\ncy = {}\nskew = 0.0\n\n[distortion]\nk1 = {}\nk2 = 0.0\nk3 = 0.0\np1 = 0.0\np2 = 0.0",
         cfg.metres_per_px,
         cfg.width,
         cfg.height,
         cfg.mount_px[0] * cfg.metres_per_px,
         cfg.mount_px[1] * cfg.metres_per_px,
         (cfg.width as f64 - 1.0) / 2.0,
-        (cfg.height as f64 - 1.0) / 2.0
+        (cfg.height as f64 - 1.0) / 2.0,
+        cfg.k1
     )?;
     cam.flush()?;
     outln!(
@@ -124,7 +149,12 @@ pub fn run(a: GroundArgs) -> Result<()> {
         cfg.width,
         cfg.height,
         format!("{texture:?}").to_lowercase(),
-        if a.hard { ", hard" } else { "" },
+        match (a.hard, cfg.supersample > 1 || cfg.k1 != 0.0 || cfg.vignetting > 0.0) {
+            (false, false) => "",
+            (true, false) => ", hard",
+            (false, true) => ", real camera",
+            (true, true) => ", hard, real camera",
+        },
         a.out.display()
     );
     Ok(())

@@ -277,6 +277,10 @@ const CASES: &[Case] = &[
     c("generate ground --frames 1000000 --out {O}", Usage(&["--frames", "range"])),
     c("generate ground --texture marble --out {O}", Usage(&["marble"])),
     c("synth ground --seed -4 --out {O}", Usage(&["--seed"])),
+    c("synth ground --supersample 0 --out {O}", Usage(&["--supersample", "range"])),
+    c("synth ground --k1 NaN --out {O}", Usage(&["--k1", "range"])),
+    c("synth ground --k1 -0.9 --out {O}", Usage(&["--k1", "range"])),
+    c("synth ground --vignetting 1 --out {O}", Usage(&["--vignetting", "range"])),
     // ---- bench
     c("bench saliency --width 100000 --height 100000", Usage(&["--width", "range"])),
     c("bench saliency --height 0", Usage(&["--height", "range"])),

@@ -11,6 +11,13 @@
 //!   from the robot's rotation centre (seed eq. 20's offset).
 //! - **Camera:** image x to the robot's right, image y backwards; one image pixel is one
 //!   ground pixel at the nominal height (`metres_per_px` on the floor).
+//! - **Real-camera rendering** (off in [`GroundConfig::easy`] and [`GroundConfig::hard`]):
+//!   pixels that integrate light over their area (`supersample` x `supersample` point samples
+//!   per pixel, averaged: a box filter over the pixel, where a point sample aliases fine
+//!   texture), radial lens distortion `k1` (the Brown model of `ocellus_geometry::distortion`
+//!   about the image centre with focal [`FOCAL_PX`]: the frame is what the lens shows, and
+//!   the camera file carries `k1` for the odometry to undistort), and vignetting (brightness
+//!   falling as `1 - vignetting (r / r_corner)^2` from the centre to the corners).
 //! - **Hard variant:** motion blur (sub-frame renders over the exposure, centred on the frame
 //!   time, averaged), gain
 //!   flicker, a camera-height oscillation the planar model does not know, stronger noise.
@@ -24,6 +31,10 @@ use ocellus_image::Plane;
 
 /// Side of a floor tile, texels.
 pub const TILE: usize = 512;
+
+/// Focal length of the generated camera, pixels (its camera file says so; with a camera
+/// height of 0.3 m one ground pixel is 0.5 mm).
+pub const FOCAL_PX: f64 = 600.0;
 
 /// What the floor is made of.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,6 +88,14 @@ pub struct GroundConfig {
     pub gain_flicker: f32,
     /// Camera-height oscillation amplitude (0.01: +-1 % image scale).
     pub height_oscillation: f64,
+    /// Point samples per pixel side, averaged (1: a point sample at the pixel centre; 2 and
+    /// up: the pixel integrates light over its area), 1..=8.
+    pub supersample: usize,
+    /// Radial distortion k1 of the lens (normalized coordinates, focal [`FOCAL_PX`]), in
+    /// [-0.5, 0.5]; 0: a perfect pinhole.
+    pub k1: f64,
+    /// Brightness lost at the image corners, in [0, 1) (0: none; 0.3: corners at 70 %).
+    pub vignetting: f32,
 }
 
 impl GroundConfig {
@@ -103,7 +122,16 @@ impl GroundConfig {
             exposure: 0.5,
             gain_flicker: 0.0,
             height_oscillation: 0.0,
+            supersample: 1,
+            k1: 0.0,
+            vignetting: 0.0,
         }
+    }
+
+    /// `self` seen by a real camera: pixels integrating over their area (2 x 2 samples), lens
+    /// distortion k1 = -0.05 and 25 % vignetting at the corners.
+    pub fn real_camera(self) -> Self {
+        Self { supersample: 2, k1: -0.05, vignetting: 0.25, ..self }
     }
 
     /// The hard sequence: as [`GroundConfig::easy`] with noise sigma 5, motion blur over half
@@ -147,6 +175,17 @@ impl GroundConfig {
         }
         if !(1..=64).contains(&self.blur_subframes) || self.height_oscillation.abs() >= 0.5 {
             return bad(format!("{} sub-frames, height oscillation {}", self.blur_subframes, self.height_oscillation));
+        }
+        let usable = (1..=8).contains(&self.supersample)
+            && self.k1.is_finite()
+            && self.k1.abs() <= 0.5
+            && self.vignetting.is_finite()
+            && (0.0..1.0).contains(&self.vignetting);
+        if !usable {
+            return bad(format!(
+                "supersample {} (1..=8), k1 {} ([-0.5, 0.5]), vignetting {} ([0, 1))",
+                self.supersample, self.k1, self.vignetting
+            ));
         }
         Ok(())
     }
@@ -198,6 +237,11 @@ pub struct GroundScene {
     textures: [Plane<f32>; 3],
     motion: Vec<BodyMotion>,
     poses: Vec<Pose2>,
+    /// Per pixel (row-major), its `supersample^2` sample points as ideal (undistorted)
+    /// offsets from the image centre, pixels (right, back).
+    rays: Vec<[f64; 2]>,
+    /// Per pixel, the vignetting factor times 1 / supersample^2.
+    shading: Vec<f32>,
 }
 
 impl GroundScene {
@@ -230,7 +274,8 @@ impl GroundScene {
             poses.push(p);
             p = p.step(m.lateral_px, m.forward_px, m.yaw_rad);
         }
-        Ok(Self { cfg, textures, motion, poses })
+        let (rays, shading) = sample_rays(&cfg)?;
+        Ok(Self { cfg, textures, motion, poses, rays, shading })
     }
 
     /// The configuration.
@@ -323,21 +368,26 @@ impl GroundScene {
         1.0 + self.cfg.height_oscillation * (std::f64::consts::TAU * t / 37.0).sin()
     }
 
-    /// Renders frame `k` (grey in [0, 1], before gain and noise) at the exact pose, no blur.
+    /// Renders frame `k` (grey in [0, 1], before gain and noise) at the exact pose, no blur:
+    /// each pixel's sample rays (see [`sample_rays`]) on the floor, averaged and shaded.
     fn render_at(&self, pose: &Pose2, scale: f64, out: &mut Plane<f32>, weight: f32) {
         let (w, h) = (self.cfg.width, self.cfg.height);
-        let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
+        let n = self.cfg.supersample * self.cfg.supersample;
         let cam = pose.point(self.cfg.mount_px[0], self.cfg.mount_px[1]);
         let (r, f) = pose.axes();
         let mut cache = ((i64::MAX, i64::MAX), TileLook { texture: 0, rot: 0, flip: false });
         for v in 0..h {
-            let back = (v as f64 - cy) * scale;
             let row = out.row_mut(v);
             for (u, o) in row.iter_mut().enumerate() {
-                let right = (u as f64 - cx) * scale;
-                let gx = cam[0] + r[0] * right - f[0] * back;
-                let gy = cam[1] + r[1] * right - f[1] * back;
-                *o += weight * self.floor(gx, gy, &mut cache);
+                let i = v * w + u;
+                let mut sum = 0.0f32;
+                for ray in &self.rays[i * n..(i + 1) * n] {
+                    let (right, back) = (ray[0] * scale, ray[1] * scale);
+                    let gx = cam[0] + r[0] * right - f[0] * back;
+                    let gy = cam[1] + r[1] * right - f[1] * back;
+                    sum += self.floor(gx, gy, &mut cache);
+                }
+                *o += weight * (self.shading[i] * sum);
             }
         }
     }
@@ -378,6 +428,45 @@ impl GroundScene {
             v.round().clamp(0.0, 255.0) as u8
         }))
     }
+}
+
+/// Each pixel's sample points and shading for `cfg`: `supersample^2` points spread evenly
+/// over the pixel (offsets `(i + 1/2) / s - 1/2`), each taken through the lens (distorted
+/// pixel to ideal pixel by the Brown model with `k1` about the centre, focal [`FOCAL_PX`]) as
+/// offsets (right, back) from the image centre; and per pixel the vignetting factor over the
+/// number of samples. With one sample, no distortion and no vignetting the ray is the pixel's
+/// own offset and the factor exactly 1: the point-sampled rendering.
+fn sample_rays(cfg: &GroundConfig) -> Result<(Vec<[f64; 2]>, Vec<f32>)> {
+    use ocellus_geometry::camera::Intrinsics;
+    use ocellus_geometry::distortion::Distortion;
+    let (w, h, s) = (cfg.width, cfg.height, cfg.supersample);
+    let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
+    let k = Intrinsics { fx: FOCAL_PX, fy: FOCAL_PX, cx, cy, skew: 0.0 };
+    let lens = Distortion { k1: cfg.k1, ..Distortion::default() };
+    let offsets: Vec<f64> = (0..s).map(|i| if s == 1 { 0.0 } else { (i as f64 + 0.5) / s as f64 - 0.5 }).collect();
+    let mut rays = Vec::with_capacity(w * h * s * s);
+    let mut shading = Vec::with_capacity(w * h);
+    let corner2 = cx * cx + cy * cy;
+    for v in 0..h {
+        for u in 0..w {
+            for &dy in &offsets {
+                for &dx in &offsets {
+                    let (pu, pv) = (u as f64 + dx, v as f64 + dy);
+                    let (iu, iv) = if cfg.k1 == 0.0 {
+                        (pu, pv)
+                    } else {
+                        lens.undistort_pixel(&k, pu, pv).map_err(|e| {
+                            SynthError::InvalidConfig(format!("k1 {}: pixel ({pu}, {pv}) has no ray: {e}", cfg.k1))
+                        })?
+                    };
+                    rays.push([iu - cx, iv - cy]);
+                }
+            }
+            let r2 = ((u as f64 - cx).powi(2) + (v as f64 - cy).powi(2)) / corner2.max(1e-12);
+            shading.push((1.0 - cfg.vignetting * r2 as f32) / (s * s) as f32);
+        }
+    }
+    Ok((rays, shading))
 }
 
 /// One wheel-odometry sample: the robot-frame motion reported over one encoder interval.
@@ -519,5 +608,108 @@ mod tests {
         assert_eq!(slips, 3);
         // 29/30 s of the 199/200 s covered; 1 % noise per sample.
         assert!((reported - true_fwd).abs() < 0.03 * true_fwd, "{reported} vs {true_fwd}");
+    }
+
+    /// A real photo's texture (fine detail that point samples alias), as the CLI loads it.
+    fn photo_textures() -> [Plane<f32>; 3] {
+        let load = |n: &str| -> Plane<f32> { ocellus_io::read_image(ocellus_testdata::asset(n)).unwrap().to_grey() };
+        [load("brick.png"), load("grass.png"), load("gravel.png")]
+    }
+
+    fn mean(p: &Plane<u8>, x0: usize, y0: usize, x1: usize, y1: usize) -> f64 {
+        let n = ((x1 - x0) * (y1 - y0)) as f64;
+        (y0..y1).flat_map(|y| (x0..x1).map(move |x| (x, y))).map(|(x, y)| f64::from(p.get(x, y))).sum::<f64>() / n
+    }
+
+    #[test]
+    fn pixels_that_integrate_their_area_keep_the_brightness_and_lose_the_aliasing() {
+        let cfg = GroundConfig {
+            width: 160,
+            height: 120,
+            frames: 2,
+            noise_sigma: 0.0,
+            ..GroundConfig::easy(GroundTexture::Gravel, 1)
+        };
+        let point = GroundScene::new(cfg, photo_textures()).unwrap().frame(1).unwrap();
+        let area =
+            GroundScene::new(GroundConfig { supersample: 4, ..cfg }, photo_textures()).unwrap().frame(1).unwrap();
+        let (mp, ma) = (mean(&point, 0, 0, 160, 120), mean(&area, 0, 0, 160, 120));
+        assert!((mp - ma).abs() < 0.5, "mean grey {mp} vs {ma}");
+        // Total variation between neighbours: a box filter over each pixel smooths what a
+        // point sample of the bilinear texture keeps.
+        let tv = |p: &Plane<u8>| -> f64 {
+            (0..120)
+                .flat_map(|y| (1..160).map(move |x| (x, y)))
+                .map(|(x, y)| (f64::from(p.get(x, y)) - f64::from(p.get(x - 1, y))).abs())
+                .sum()
+        };
+        let (tp, ta) = (tv(&point), tv(&area));
+        assert!(ta < 0.97 * tp, "variation point {tp} vs area {ta}");
+        // One sample per pixel is the point-sampled rendering, exactly.
+        let one = GroundScene::new(GroundConfig { supersample: 1, k1: 0.0, vignetting: 0.0, ..cfg }, photo_textures())
+            .unwrap();
+        assert_eq!(one.frame(1).unwrap(), point);
+    }
+
+    #[test]
+    fn vignetting_darkens_the_corners_by_the_share_asked() {
+        let flat = [
+            Plane::from_fn(TILE, TILE, |_, _| 0.8f32),
+            Plane::from_fn(TILE, TILE, |_, _| 0.8),
+            Plane::from_fn(TILE, TILE, |_, _| 0.8),
+        ];
+        let cfg = GroundConfig { vignetting: 0.3, ..small(GroundTexture::Brick) };
+        let f = GroundScene::new(cfg, flat).unwrap().frame(0).unwrap();
+        let lit = (0.8f32 * 255.0).round();
+        // Corner pixel: r = r_corner; centre: r about 0.
+        assert!((f32::from(f.get(0, 0)) - (0.7 * 0.8f32 * 255.0).round()).abs() <= 1.0, "{}", f.get(0, 0));
+        assert!((f32::from(f.get(48, 32)) - lit).abs() <= 1.0, "{}", f.get(48, 32));
+    }
+
+    #[test]
+    fn a_distorted_frame_undistorted_by_its_own_model_is_the_pinhole_frame() {
+        use ocellus_geometry::camera::Intrinsics;
+        use ocellus_geometry::distortion::{remap_bilinear, undistort_maps, Distortion};
+        let cfg = GroundConfig {
+            width: 320,
+            height: 240,
+            frames: 2,
+            noise_sigma: 0.0,
+            ..GroundConfig::easy(GroundTexture::Mosaic, 2)
+        };
+        let pinhole = GroundScene::new(cfg, textures()).unwrap().frame(1).unwrap();
+        let lens = GroundScene::new(GroundConfig { k1: -0.2, ..cfg }, textures()).unwrap().frame(1).unwrap();
+        let k = Intrinsics { fx: FOCAL_PX, fy: FOCAL_PX, cx: 159.5, cy: 119.5, skew: 0.0 };
+        let d = Distortion { k1: -0.2, ..Distortion::default() };
+        let (mx, my) = undistort_maps(&k, &d, 320, 240);
+        let back = remap_bilinear(&lens.map(f32::from), &mx, &my, 0.0).unwrap();
+        let diff = |a: &Plane<f32>, x: usize, y: usize| (a.get(x, y) - f32::from(pinhole.get(x, y))).abs();
+        // Inside a margin (the remap reads outside the frame near the border).
+        let pts: Vec<(usize, usize)> = (12..228).flat_map(|y| (12..308).map(move |x| (x, y))).collect();
+        let mean_diff = pts.iter().map(|&(x, y)| f64::from(diff(&back, x, y))).sum::<f64>() / pts.len() as f64;
+        assert!(mean_diff < 1.0, "undistorted lens frame vs pinhole frame: {mean_diff} grey levels");
+        // The distortion is visible before undistortion (the corners move by 4 px).
+        let raw = pts
+            .iter()
+            .map(|&(x, y)| f64::from((f32::from(lens.get(x, y)) - f32::from(pinhole.get(x, y))).abs()))
+            .sum::<f64>()
+            / pts.len() as f64;
+        assert!(raw > 3.0 * mean_diff, "raw {raw} vs undistorted {mean_diff}");
+    }
+
+    #[test]
+    fn unusable_real_camera_settings_are_refused() {
+        let ok = small(GroundTexture::Grass);
+        for cfg in [
+            GroundConfig { supersample: 0, ..ok },
+            GroundConfig { supersample: 9, ..ok },
+            GroundConfig { k1: f64::NAN, ..ok },
+            GroundConfig { k1: 0.8, ..ok },
+            GroundConfig { vignetting: 1.0, ..ok },
+            GroundConfig { vignetting: -0.1, ..ok },
+        ] {
+            assert!(GroundScene::new(cfg, textures()).is_err(), "{cfg:?}");
+        }
+        assert!(GroundScene::new(ok.real_camera(), textures()).is_ok());
     }
 }
