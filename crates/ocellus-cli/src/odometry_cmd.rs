@@ -324,7 +324,12 @@ fn eval(a: &EvalArgs) -> Result<()> {
         e.final_drift_percent,
         e.final_heading_deg
     );
-    outln!("ATE RMSE {:.3} mm, RPE per frame RMSE {:.4} mm", e.ate_rmse_m * 1e3, e.rpe_rmse_m * 1e3);
+    outln!(
+        "ATE RMSE {:.3} mm ({:.3} mm after a rigid alignment), RPE per frame RMSE {:.4} mm",
+        e.ate_rmse_m * 1e3,
+        e.ate_aligned_rmse_m * 1e3,
+        e.rpe_rmse_m * 1e3
+    );
     let pairs: Vec<(TumPose, TumPose)> = index_pairs.into_iter().map(|(i, j)| (est[i], gt[j])).collect();
     let (e, g): (Vec<TumPose>, Vec<TumPose>) = pairs.into_iter().unzip();
     plot_trajectories(&a.plot, &[("ground truth", &g, RGBColor(30, 30, 30)), ("estimate", &e, RGBColor(200, 40, 40))])?;
