@@ -1,8 +1,10 @@
 # The odometry an OpenCV user would write (issue 7's baseline): pyramidal Lucas-Kanade on a
 # 20x20 grid of 400 points over the central 400x400 pixels, then RANSAC partial affine (a
 # rotation, translation and scale) between consecutive frames, integrated with the same
-# camera mount kinematics as ocellus. Writes a TUM trajectory and prints the median ms per
-# frame (LK + RANSAC, one thread).
+# camera mount kinematics as ocellus. A lens with distortion in the camera file (k1 k2 p1 p2
+# k3) is undistorted as an OpenCV user would: the tracked points through cv2.undistortPoints.
+# Writes a TUM trajectory and prints the median ms per frame (LK + undistortion + RANSAC, one
+# thread).
 #
 # Usage: python lk_odometry.py FRAMES_DIR CAMERA.toml OUT.tum [RATE_HZ]
 import math
@@ -34,6 +36,15 @@ def main():
     scale = cam["height_m"] / (0.5 * (cam["fx"] + cam["fy"]))
     mount_r, mount_f = cam.get("mount_right_m", 0.0), cam.get("mount_forward_m", 0.0)
     cx, cy = cam["cx"], cam["cy"]
+    K = np.array([[cam["fx"], 0.0, cx], [0.0, cam["fy"], cy], [0.0, 0.0, 1.0]])
+    dist = np.array([cam.get(k, 0.0) for k in ("k1", "k2", "p1", "p2", "k3")])
+    lens = bool(np.any(dist != 0.0))
+
+    def ideal(pts):
+        if not lens:
+            return pts
+        return cv2.undistortPoints(pts.reshape(-1, 1, 2), K, dist, P=K).reshape(-1, 2)
+
     cv2.setNumThreads(1)
     names = sorted(n for n in os.listdir(frames_dir) if n.endswith(".png"))
     frames = [cv2.imread(os.path.join(frames_dir, n), cv2.IMREAD_GRAYSCALE) for n in names]
@@ -53,8 +64,8 @@ def main():
         t = time.perf_counter()
         nxt, st, _ = cv2.calcOpticalFlowPyrLK(prev, cur, grid, None, winSize=(21, 21), maxLevel=3)
         ok = st.ravel() == 1
-        a = grid[ok] - (cx, cy)
-        b = nxt[ok] - (cx, cy)
+        a = ideal(grid[ok]) - (cx, cy)
+        b = ideal(nxt[ok]) - (cx, cy)
         m, _ = cv2.estimateAffinePartial2D(a, b, method=cv2.RANSAC, ransacReprojThreshold=1.0)
         times.append((time.perf_counter() - t) * 1e3)
         if m is None:
