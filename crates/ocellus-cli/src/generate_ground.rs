@@ -5,6 +5,9 @@ use crate::assets;
 use crate::ranges;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
+use ocellus_geometry::camera::Intrinsics;
+use ocellus_geometry::camera_file::{self, CameraFile};
+use ocellus_geometry::distortion::Distortion;
 use ocellus_image::convert::RgbImage;
 use ocellus_image::Plane;
 use ocellus_io::tum::TumPose;
@@ -129,20 +132,16 @@ pub fn run(a: GroundArgs) -> Result<()> {
     }
     enc.flush()?;
     slips.flush()?;
-    let mut cam = create("camera.toml")?;
-    writeln!(
-        cam,
-        "# The generated camera: 1 ground pixel = {} m.\nimage_size = [{}, {}]\nheight_m = 0.3\nmount_right_m = {}\nmount_forward_m = {}\n\n[intrinsics]\nfx = {FOCAL_PX:.1}\nfy = {FOCAL_PX:.1}\ncx = {}\ncy = {}\nskew = 0.0\n\n[distortion]\nk1 = {}\nk2 = 0.0\nk3 = 0.0\np1 = 0.0\np2 = 0.0",
-        cfg.metres_per_px,
-        cfg.width,
-        cfg.height,
-        cfg.mount_px[0] * cfg.metres_per_px,
-        cfg.mount_px[1] * cfg.metres_per_px,
-        (cfg.width as f64 - 1.0) / 2.0,
-        (cfg.height as f64 - 1.0) / 2.0,
-        cfg.k1
-    )?;
-    cam.flush()?;
+    // 0.3 m over a focal of 600 px: one ground pixel is the config's 0.5 mm.
+    let cam = CameraFile {
+        image_size: Some([cfg.width, cfg.height]),
+        intrinsics: Intrinsics::centred(FOCAL_PX, cfg.width, cfg.height),
+        distortion: Distortion { k1: cfg.k1, ..Distortion::default() },
+        height_m: Some(0.3),
+        mount_right_m: Some(cfg.mount_px[0] * cfg.metres_per_px),
+        mount_forward_m: Some(cfg.mount_px[1] * cfg.metres_per_px),
+    };
+    camera_file::write(&a.out.join("camera.toml"), &cam)?;
     outln!(
         "{} frames {}x{} ({}{}) written to {} with groundtruth.tum, encoders.csv, encoder_slips.csv, camera.toml",
         scene.len(),

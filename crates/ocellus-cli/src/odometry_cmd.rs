@@ -231,7 +231,6 @@ pub fn run(a: OdometryArgs) -> Result<()> {
     Ok(())
 }
 
-/// The frame with its flow vectors drawn 5x longer (green) from their group centres (red).
 /// The pose of `poses` (in time order) within `tol` seconds of `t`.
 fn pose_at(poses: &[TumPose], t: f64, tol: f64) -> Option<[f64; 3]> {
     let i = poses.partition_point(|p| p.time_s < t - tol);
@@ -273,6 +272,7 @@ fn log_step(
     Ok(())
 }
 
+/// The frame with its flow vectors drawn 5x longer (green) from their group centres (red).
 fn write_flow(path: &Path, grey: &Plane<u8>, flows: &[ocellus_odometry::sad_flow::FlowPoint]) -> Result<()> {
     let (w, h) = grey.size();
     let mut img = grey.map(|v| [v, v, v]);

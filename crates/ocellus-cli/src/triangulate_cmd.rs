@@ -61,17 +61,16 @@ pub fn run(a: TriangulateArgs) -> Result<()> {
     let ps: Vec<Matrix3x4<f64>> = a.cameras.iter().map(|c| read_camera(c)).collect::<Result<_>>()?;
     ocellus_geometry::triangulate::check_rig(&ps).context("the --camera files cannot triangulate")?;
     let rows = ocellus_io::csv::read_rows(&a.matches, 2 * ps.len(), "a pixel 'u,v' per camera")?;
-    let truth = a.truth.as_deref().map(|t| ocellus_io::csv::read_rows(t, 3, "'X,Y,Z'")).transpose()?;
-    if let Some(t) = &truth {
-        if t.len() != rows.len() {
-            bail!(
-                "{} has {} points for {} matches",
-                a.truth.as_deref().unwrap_or(Path::new("")).display(),
-                t.len(),
-                rows.len()
-            );
+    let truth = match &a.truth {
+        Some(path) => {
+            let t = ocellus_io::csv::read_rows(path, 3, "'X,Y,Z'")?;
+            if t.len() != rows.len() {
+                bail!("{} has {} points for {} matches", path.display(), t.len(), rows.len());
+            }
+            Some(t)
         }
-    }
+        None => None,
+    };
     let mut points = Vec::with_capacity(rows.len());
     let mut out = crate::output_files::create_file(&a.out)?;
     writeln!(out, "x,y,z,in_front,rms_px")?;

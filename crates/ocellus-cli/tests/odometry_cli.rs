@@ -30,7 +30,7 @@ fn generate_estimate_and_evaluate_a_ground_sequence() {
         .arg(seq.join("groundtruth.tum"))
         .arg("--plot")
         .arg(dir.join("p.png")));
-    let drift: f64 = e.split("final drift ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap();
+    let drift = final_drift(&e);
     // Seed mode on gravel over 40 frames: a few percent at most (a broken sign or scale
     // gives tens or hundreds).
     assert!(drift < 10.0, "{e}");
@@ -81,7 +81,7 @@ fn a_real_camera_floor_is_undistorted_by_its_camera_file_and_tracked() {
         .arg(seq.join("groundtruth.tum"))
         .arg("--plot")
         .arg(dir.join("p.png")));
-    let drift: f64 = e.split("final drift ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap();
+    let drift = final_drift(&e);
     // The robust mode on real-camera gravel drifts 0.0104 % over 200 frames; with the lens
     // left undistorted (k1 = 0 in the camera file) 0.71 %.
     assert!(drift < 0.5, "{e}");
@@ -105,4 +105,9 @@ fn odometry_errors_are_clear() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+}
+
+/// The final drift (percent) that `odometry eval` printed.
+fn final_drift(eval_output: &str) -> f64 {
+    eval_output.split("final drift ").nth(1).and_then(|t| t.split(' ').next()).unwrap().parse().unwrap()
 }

@@ -441,7 +441,7 @@ fn sample_rays(cfg: &GroundConfig) -> Result<(Vec<[f64; 2]>, Vec<f32>)> {
     use ocellus_geometry::distortion::Distortion;
     let (w, h, s) = (cfg.width, cfg.height, cfg.supersample);
     let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
-    let k = Intrinsics { fx: FOCAL_PX, fy: FOCAL_PX, cx, cy, skew: 0.0 };
+    let k = Intrinsics::centred(FOCAL_PX, w, h);
     let lens = Distortion { k1: cfg.k1, ..Distortion::default() };
     let offsets: Vec<f64> = (0..s).map(|i| if s == 1 { 0.0 } else { (i as f64 + 0.5) / s as f64 - 0.5 }).collect();
     let mut rays = Vec::with_capacity(w * h * s * s);
