@@ -24,8 +24,9 @@ enum What {
     /// Views of a chessboard over a real photo, rendered through a known distorted camera, with
     /// the true camera and corner positions (try `ocellus calibrate chessboard` on them).
     Chessboard(crate::generate_chessboard::ChessboardArgs),
-    /// A camera looking down at a floor of real textures (brick, grass, gravel, mosaic) with
-    /// known planar motion at 200 Hz: frames, TUM ground truth, wheel encoders (odometry).
+    /// A camera looking down at a floor of real textures (brick, grass, gravel, mosaic, and
+    /// low-contrast, fine-grained and repetitive floors made from them) with known planar
+    /// motion at 200 Hz: frames, TUM ground truth, wheel encoders (odometry).
     Ground(crate::generate_ground::GroundArgs),
     /// A shaded coloured ball thrown, bouncing or approaching in 3D in front of a real photo,
     /// through a known distorted camera, with occluders, a distractor, a lighting change and

@@ -27,6 +27,12 @@ pub enum TextureArg {
     Gravel,
     /// Tiles of all three.
     Mosaic,
+    /// Dim, smoothed grass with 8 grey levels of texture.
+    LowContrast,
+    /// Gravel shrunk by 4: grains a few pixels across.
+    FineGrained,
+    /// A 20-pixel square of gravel repeated (periodic with the seed's search window).
+    Repetitive,
 }
 
 /// Arguments of `ocellus generate ground`.
@@ -85,6 +91,9 @@ pub fn run(a: GroundArgs) -> Result<()> {
         TextureArg::Grass => GroundTexture::Grass,
         TextureArg::Gravel => GroundTexture::Gravel,
         TextureArg::Mosaic => GroundTexture::Mosaic,
+        TextureArg::LowContrast => GroundTexture::LowContrast,
+        TextureArg::FineGrained => GroundTexture::FineGrained,
+        TextureArg::Repetitive => GroundTexture::Repetitive,
     };
     let base = if a.hard { GroundConfig::hard(texture, a.seed) } else { GroundConfig::easy(texture, a.seed) };
     let base = if a.real_camera { base.real_camera() } else { base };
@@ -147,7 +156,7 @@ pub fn run(a: GroundArgs) -> Result<()> {
         scene.len(),
         cfg.width,
         cfg.height,
-        format!("{texture:?}").to_lowercase(),
+        texture.name(),
         match (a.hard, cfg.supersample > 1 || cfg.k1 != 0.0 || cfg.vignetting > 0.0) {
             (false, false) => "",
             (true, false) => ", hard",

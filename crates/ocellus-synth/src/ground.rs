@@ -3,7 +3,9 @@
 //!
 //! - **Floor:** square tiles of a real texture (brick, grass or gravel, 512x512), each turned
 //!   by a multiple of 90 degrees and possibly mirrored, or a mosaic mixing the three; all
-//!   chosen per tile from the seed. The floor is a grid of texels (one per ground pixel),
+//!   chosen per tile from the seed. Three harder floors are made from the photos by
+//!   [`crate::floors`]: low-contrast (grass, smoothed, 8 grey levels of texture), fine-grained
+//!   (gravel shrunk by 4) and repetitive (a 20-pixel square of gravel repeated). The floor is a grid of texels (one per ground pixel),
 //!   sampled bilinearly.
 //! - **Motion:** the robot's forward speed, lateral speed and yaw rate vary smoothly (sums of
 //!   seeded sinusoids) within `forward_px` +- `forward_spread_px`, +- `lateral_px`, and
@@ -47,6 +49,32 @@ pub enum GroundTexture {
     Gravel,
     /// Each tile one of the three.
     Mosaic,
+    /// Dim grass, smoothed, with its contrast cut to 8 grey levels ([`crate::floors::low_contrast`]).
+    LowContrast,
+    /// Gravel shrunk by 4: grains a few pixels across ([`crate::floors::fine_grained`]).
+    FineGrained,
+    /// A 20-pixel square of gravel repeated: periodic with the seed's search window
+    /// ([`crate::floors::repetitive`]).
+    Repetitive,
+}
+
+impl GroundTexture {
+    /// Every floor, in the order of the odometry tables.
+    pub const ALL: [Self; 7] =
+        [Self::Brick, Self::Grass, Self::Gravel, Self::Mosaic, Self::LowContrast, Self::FineGrained, Self::Repetitive];
+
+    /// The floor's name in lower case with hyphens (as the command line spells it).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Brick => "brick",
+            Self::Grass => "grass",
+            Self::Gravel => "gravel",
+            Self::Mosaic => "mosaic",
+            Self::LowContrast => "low-contrast",
+            Self::FineGrained => "fine-grained",
+            Self::Repetitive => "repetitive",
+        }
+    }
 }
 
 /// A ground sequence's configuration.
@@ -234,7 +262,8 @@ struct TileLook {
 #[derive(Clone, Debug)]
 pub struct GroundScene {
     cfg: GroundConfig,
-    textures: [Plane<f32>; 3],
+    /// The tiles' textures: the three photos, or the one floor made from them.
+    textures: Vec<Plane<f32>>,
     motion: Vec<BodyMotion>,
     poses: Vec<Pose2>,
     /// Per pixel (row-major), its `supersample^2` sample points as ideal (undistorted)
@@ -246,7 +275,8 @@ pub struct GroundScene {
 
 impl GroundScene {
     /// Builds the sequence from the three textures (brick, grass, gravel; grey in [0, 1] as
-    /// [`ocellus_image::convert::RgbImage::to_grey`] makes it, each `TILE` x `TILE`).
+    /// [`ocellus_image::convert::RgbImage::to_grey`] makes it, each `TILE` x `TILE`); the
+    /// low-contrast, fine-grained and repetitive floors are made from them.
     pub fn new(cfg: GroundConfig, textures: [Plane<f32>; 3]) -> Result<Self> {
         cfg.check()?;
         if textures.iter().any(|t| t.size() != (TILE, TILE)) {
@@ -255,6 +285,13 @@ impl GroundScene {
         if textures.iter().any(|t| t.rows().flatten().any(|v| !(0.0..=1.0).contains(v))) {
             return Err(SynthError::InvalidConfig("ground textures must hold grey levels in [0, 1]".into()));
         }
+        let [brick, grass, gravel] = textures;
+        let textures = match cfg.texture {
+            GroundTexture::LowContrast => vec![crate::floors::low_contrast(&grass)?],
+            GroundTexture::FineGrained => vec![crate::floors::fine_grained(&gravel)?],
+            GroundTexture::Repetitive => vec![crate::floors::repetitive(&gravel)?],
+            _ => vec![brick, grass, gravel],
+        };
         let mut rng = SplitMix64::new(cfg.seed ^ 0x6f64_6f6d);
         let (sf, sl, sy) = (Smooth::new(&mut rng), Smooth::new(&mut rng), Smooth::new(&mut rng));
         let motion: Vec<BodyMotion> = (0..cfg.frames)
@@ -326,6 +363,7 @@ impl GroundScene {
             GroundTexture::Grass => 1,
             GroundTexture::Gravel => 2,
             GroundTexture::Mosaic => ((v >> 8) % 3) as usize,
+            GroundTexture::LowContrast | GroundTexture::FineGrained | GroundTexture::Repetitive => 0,
         };
         TileLook { texture, rot: (v & 3) as u8, flip: v & 4 != 0 }
     }

@@ -34,6 +34,7 @@ pub mod ball_view;
 pub mod ball_world;
 pub mod chessboard;
 pub mod corridor;
+pub mod floors;
 pub mod ground;
 pub mod texture;
 
