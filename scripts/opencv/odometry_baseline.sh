@@ -4,8 +4,9 @@
 # easy and hard, each also as a real camera sees it (`synth ground --real-camera`: area pixels,
 # lens distortion, vignetting; variants real-easy, real-hard). Prints one line per run:
 # texture variant seed, then final drift % of the path, final heading error (degrees) and ATE
-# RMSE (mm) of each. Needs the venv of run.sh (network once). VARIANTS="real-easy" ./... runs
-# a subset.
+# RMSE (mm) of each. Needs the venv of run.sh (network once). VARIANTS="real-easy" and
+# TEXTURES="low-contrast fine-grained" ./... run a subset; the default is every floor
+# (brick grass gravel mosaic low-contrast fine-grained repetitive) and every variant.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 source scripts/opencv/venv.sh
@@ -17,7 +18,7 @@ drift() {
     awk '/final drift/ {d = $3; h = $11} /ATE RMSE/ {a = $3} END {printf "%s %s %s", d, h, a}'
 }
 echo "texture variant seed | lk_drift_% lk_heading_deg lk_ate_mm lk_ms | ocellus_drift_% ocellus_heading_deg ocellus_ate_mm"
-for tex in brick grass gravel mosaic; do
+for tex in ${TEXTURES:-brick grass gravel mosaic low-contrast fine-grained repetitive}; do
   for variant in ${VARIANTS:-easy hard real-easy real-hard}; do
     for seed in 1 2 3; do
       flag=""

@@ -25,6 +25,7 @@
 
 pub mod fusion;
 pub mod kinematics;
+pub mod lucas_kanade;
 pub mod robust;
 pub mod sad_flow;
 pub mod vo;

@@ -2,12 +2,16 @@
 //! robust fit of the camera motion over all windows.
 //!
 //! 1. Every window's integer SAD match ([`crate::sad_flow::window_flows`]) is refined by
-//!    Gauss-Newton steps of Lucas-Kanade on the block (Lucas & Kanade 1981): with the image
-//!    gradients g of frame n at the matched block, the correction solves
-//!    `(sum g g^T) d = -sum g (I_n - I_n-1)`. The 2x2 structure tensor `sum g g^T` is also the
-//!    window's information: a block on a straight mortar line constrains the flow across the
-//!    line only (the aperture problem), and a flat block nothing; blocks whose smaller
-//!    eigenvalue is below `min_texture` are dropped.
+//!    Gauss-Newton steps of Lucas-Kanade (Lucas & Kanade 1981, [`crate::lucas_kanade`]) over
+//!    a `lk_support` square about the block, on both frames smoothed by a Gaussian of
+//!    `smooth_sigma_px`: with the image gradients g of frame n at the matched square, the
+//!    correction solves `(sum g g^T) d = -sum g (I_n - I_n-1)`. The 2x2 structure tensor
+//!    `sum g g^T` over the window's own noise (the variance its residual leaves per pixel) is
+//!    the window's information: a square on a straight mortar line constrains the flow across
+//!    the line only (the aperture problem), and a flat one nothing. Windows whose flow is
+//!    uncertain by more than `max_flow_sigma_px` across their weakest direction are dropped:
+//!    a test relative to the noise, which an absolute texture threshold is not (a dim,
+//!    low-contrast floor has gradients below one grey level per pixel and is still usable).
 //! 2. The camera's planar motion (right, forward, turn) is fitted to all the windows at once
 //!    with the exact rigid model (not its first-order Jacobian), by iteratively reweighted
 //!    Gauss-Newton with Cauchy weights (scale `cauchy_px`), so that windows on moving or
@@ -18,6 +22,7 @@
 //! `r` to the right and `f` forward and turns clockwise by `w`): a floor point at (u, v) in
 //! frame n-1 is seen at `u' = (u - r) cos w + (v + f) sin w`, `v' = -(u - r) sin w + (v + f) cos w`.
 
+use crate::lucas_kanade::{lk_sums, smooth, DEFAULT_SMOOTH_SIGMA_PX};
 use crate::sad_flow::{window_flows, SadFlowConfig};
 use crate::{OdometryError, Result};
 use nalgebra::{Matrix3, Matrix4, Vector4};
@@ -31,21 +36,78 @@ pub struct RobustConfig {
     pub flow: SadFlowConfig,
     /// Lucas-Kanade steps per window.
     pub lk_steps: usize,
-    /// Least texture kept: smaller eigenvalue of the structure tensor per block pixel
-    /// (grey levels squared per pixel squared).
-    pub min_texture: f64,
+    /// Side of the square that Lucas-Kanade refines each window's flow over, centred on the
+    /// matched block, pixels: at least the block, with the same parity, at most the window.
+    #[serde(default = "default_lk_support")]
+    pub lk_support: usize,
+    /// Sigma of the Gaussian both frames are smoothed with before Lucas-Kanade, pixels, in
+    /// [0, 5] (0: none; see [`crate::lucas_kanade`]).
+    #[serde(default = "default_smooth_sigma")]
+    pub smooth_sigma_px: f32,
+    /// Largest standard deviation of a window's flow across its weakest direction, pixels:
+    /// windows that cannot pin their flow better are dropped (see [`window_measurements`]).
+    #[serde(default = "default_max_flow_sigma")]
+    pub max_flow_sigma_px: f64,
     /// Scale of the Cauchy weights, pixels.
     pub cauchy_px: f64,
     /// Residual beyond which a window is dropped after the first fit, pixels.
     pub reject_px: f64,
 }
 
-impl Default for RobustConfig {
-    /// The seed's search, 2 Lucas-Kanade steps, texture at least 4, Cauchy scale 0.3 px,
-    /// rejection at 1 px.
-    fn default() -> Self {
-        Self { flow: SadFlowConfig::default(), lk_steps: 2, min_texture: 4.0, cauchy_px: 0.3, reject_px: 1.0 }
+impl RobustConfig {
+    /// Checks the Lucas-Kanade settings (the search's are checked against each frame).
+    pub fn check(&self) -> Result<()> {
+        let b = self.flow.block;
+        if self.lk_support < b || self.lk_support > self.flow.window || (self.lk_support - b) % 2 != 0 {
+            return Err(OdometryError::Invalid(format!(
+                "Lucas-Kanade support {}: from the block ({b}) to the window ({}), with the block's parity",
+                self.lk_support, self.flow.window
+            )));
+        }
+        if !(self.smooth_sigma_px.is_finite() && (0.0..=5.0).contains(&self.smooth_sigma_px)) {
+            return Err(OdometryError::Invalid(format!("smoothing sigma {} px: 0..=5", self.smooth_sigma_px)));
+        }
+        if !(self.max_flow_sigma_px.is_finite() && self.max_flow_sigma_px > 0.0) {
+            return Err(OdometryError::Invalid(format!(
+                "largest flow sigma {} px must be finite and positive",
+                self.max_flow_sigma_px
+            )));
+        }
+        Ok(())
     }
+}
+
+impl Default for RobustConfig {
+    /// The seed's search, 2 Lucas-Kanade steps over 16 x 16 pixels of frames smoothed by a
+    /// Gaussian of sigma 1.5 px, windows whose flow is uncertain by more than 0.1 px dropped,
+    /// Cauchy scale 0.3 px, rejection at 1 px.
+    fn default() -> Self {
+        Self {
+            flow: SadFlowConfig::default(),
+            lk_steps: 2,
+            lk_support: default_lk_support(),
+            smooth_sigma_px: default_smooth_sigma(),
+            max_flow_sigma_px: default_max_flow_sigma(),
+            cauchy_px: 0.3,
+            reject_px: 1.0,
+        }
+    }
+}
+
+fn default_lk_support() -> usize {
+    16
+}
+
+fn default_max_flow_sigma() -> f64 {
+    0.1
+}
+
+/// Floor of the noise variance per pixel difference, grey levels squared: a noiseless
+/// synthetic frame must not give a window infinite information.
+const MIN_NOISE_VAR: f64 = 0.01;
+
+fn default_smooth_sigma() -> f32 {
+    DEFAULT_SMOOTH_SIGMA_PX
 }
 
 /// One window's sub-pixel measurement.
@@ -61,30 +123,6 @@ pub struct WindowMeasurement {
     pub dv: f64,
     /// Information of (du, dv): the structure tensor over the noise variance (1 / px^2).
     pub info: [[f64; 2]; 2],
-}
-
-/// Bilinear sample with clamping.
-fn at(img: &Plane<u8>, x: f64, y: f64) -> f64 {
-    let (w, h) = (img.width() as f64, img.height() as f64);
-    let (x, y) = (x.clamp(0.0, w - 1.0), y.clamp(0.0, h - 1.0));
-    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-    let (x1, y1) = ((x0 + 1).min(img.width() - 1), (y0 + 1).min(img.height() - 1));
-    let (ax, ay) = (x - x0 as f64, y - y0 as f64);
-    let g = |xx: usize, yy: usize| img.get(xx, yy) as f64;
-    let top = g(x0, y0) + ax * (g(x1, y0) - g(x0, y0));
-    let bot = g(x0, y1) + ax * (g(x1, y1) - g(x0, y1));
-    top + ay * (bot - top)
-}
-
-/// `x.floor()` without the library call that baseline x86-64 (no SSE4.1 `roundsd`) makes for
-/// it; exact for |x| < 2^52, which covers every pixel coordinate.
-fn floor(x: f64) -> f64 {
-    let t = x as i64 as f64;
-    if t > x {
-        t - 1.0
-    } else {
-        t
-    }
 }
 
 /// Mean grey level of the central `region` x `region` pixels, over every other row and
@@ -103,173 +141,56 @@ fn region_mean(img: &Plane<u8>, region: usize) -> f64 {
     s as f64 / n.max(1) as f64
 }
 
-/// The Lucas-Kanade normal equations of one block: `[sum gx^2, sum gx gy, sum gy^2,
-/// sum gx e, sum gy e]` with the gradients g and differences e of frame n (times `gain`)
-/// warped by (dx, dy) against frame n-1. The warp has one fractional part for the whole block,
-/// so frame n is resampled once into a patch with a one-pixel border and the gradients are
-/// central differences there (the same as sampling at +-1 pixel).
-#[allow(clippy::too_many_arguments)]
-fn lk_sums(
+/// Sub-pixel flows of all textured windows between `prev` and `cur` (smoothing both for
+/// Lucas-Kanade, see [`crate::lucas_kanade`]).
+pub fn window_measurements(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &RobustConfig) -> Result<Vec<WindowMeasurement>> {
+    let (ps, cs) = (smooth(prev, cfg.smooth_sigma_px)?, smooth(cur, cfg.smooth_sigma_px)?);
+    window_measurements_smoothed(prev, cur, &ps, &cs, cfg)
+}
+
+/// [`window_measurements`] with both frames already smoothed for Lucas-Kanade
+/// ([`crate::lucas_kanade::smooth`] with `cfg.smooth_sigma_px`; a stream smooths each frame
+/// once).
+pub fn window_measurements_smoothed(
     prev: &Plane<u8>,
     cur: &Plane<u8>,
-    bx: f64,
-    by: f64,
-    b: usize,
-    dx: f64,
-    dy: f64,
-    gain: f64,
-    patch: &mut Vec<f32>,
-) -> [f64; 5] {
-    let n = b + 2;
-    let (sx, sy) = (bx - 1.0 + dx, by - 1.0 + dy);
-    let (fx, fy) = (floor(sx), floor(sy));
-    let (ax, ay) = ((sx - fx) as f32, (sy - fy) as f32);
-    patch.clear();
-    let inside = fx >= 0.0 && fy >= 0.0 && fx as usize + n < cur.width() && fy as usize + n < cur.height();
-    if inside && b == 8 {
-        let mut p = [0.0f32; 100];
-        patch8(cur, fx as usize, fy as usize, ax, ay, &mut p);
-        return lk_sums8(prev, bx, by, &p, gain as f32);
-    }
-    if inside {
-        let (ix, iy) = (fx as usize, fy as usize);
-        if ax == 0.0 && ay == 0.0 {
-            // An integer offset (the first step): a plain copy.
-            for j in 0..n {
-                patch.extend(cur.row(iy + j)[ix..ix + n].iter().map(|&v| v as f32));
-            }
-        } else {
-            let (w00, w10, w01, w11) = ((1.0 - ax) * (1.0 - ay), ax * (1.0 - ay), (1.0 - ax) * ay, ax * ay);
-            for j in 0..n {
-                let (r0, r1) = (&cur.row(iy + j)[ix..ix + n + 1], &cur.row(iy + j + 1)[ix..ix + n + 1]);
-                for i in 0..n {
-                    patch.push(
-                        w00 * r0[i] as f32 + w10 * r0[i + 1] as f32 + w01 * r1[i] as f32 + w11 * r1[i + 1] as f32,
-                    );
-                }
-            }
-        }
-    } else {
-        for j in 0..n {
-            for i in 0..n {
-                patch.push(at(cur, sx + i as f64, sy + j as f64) as f32);
-            }
-        }
-    }
-    let g = gain as f32;
-    if b == 8 {
-        return lk_sums8(prev, bx, by, patch, g);
-    }
-    let mut s = [0.0f64; 5];
-    for j in 1..=b {
-        let prow = prev.row((by as usize + j - 1).min(prev.height() - 1));
-        let x0 = (bx as usize).min(prev.width() - b);
-        let prow = &prow[x0..x0 + b];
-        let (up, mid, down) =
-            (&patch[(j - 1) * n..j * n], &patch[j * n..(j + 1) * n], &patch[(j + 1) * n..(j + 2) * n]);
-        // One row's sums in f32 (at most 8 terms), accumulated in f64.
-        let mut r = [0.0f32; 5];
-        for i in 1..=b {
-            let gx = 0.5 * g * (mid[i + 1] - mid[i - 1]);
-            let gy = 0.5 * g * (down[i] - up[i]);
-            let e = g * mid[i] - prow[i - 1] as f32;
-            r[0] += gx * gx;
-            r[1] += gx * gy;
-            r[2] += gy * gy;
-            r[3] += gx * e;
-            r[4] += gy * e;
-        }
-        for k in 0..5 {
-            s[k] += r[k] as f64;
-        }
-    }
-    s
-}
-
-/// The 10x10 patch of `cur` (an 8x8 block and its border) whose top-left sample is at
-/// (ix + ax, iy + ay), bilinearly: each of the 11 source rows is interpolated along x once
-/// and shared by the two patch rows it touches, in fixed-size loops the compiler vectorizes.
-fn patch8(cur: &Plane<u8>, ix: usize, iy: usize, ax: f32, ay: f32, out: &mut [f32; 100]) {
-    const N: usize = 10;
-    let mut rows = [[0.0f32; N]; N + 1];
-    for (j, h) in rows.iter_mut().enumerate() {
-        let Some(src) = cur.row(iy + j).get(ix..ix + N + 1) else { continue };
-        let mut v = [0.0f32; N + 1];
-        for (d, &s) in v.iter_mut().zip(src) {
-            *d = s as f32;
-        }
-        for i in 0..N {
-            h[i] = v[i] + ax * (v[i + 1] - v[i]);
-        }
-    }
-    for j in 0..N {
-        let (t, b) = (&rows[j], &rows[j + 1]);
-        for i in 0..N {
-            out[j * N + i] = t[i] + ay * (b[i] - t[i]);
-        }
-    }
-}
-
-/// [`lk_sums`] for the default 8x8 block: the sums are kept per column in fixed 8-lane arrays,
-/// which the compiler turns into vector code, and reduced once at the end (64 terms in f32
-/// lose nothing that matters at grey-level precision).
-fn lk_sums8(prev: &Plane<u8>, bx: f64, by: f64, patch: &[f32], g: f32) -> [f64; 5] {
-    const B: usize = 8;
-    const N: usize = B + 2;
-    let mut acc = [[0.0f32; B]; 5];
-    let x0 = (bx as usize).min(prev.width() - B);
-    for j in 1..=B {
-        let prow = &prev.row((by as usize + j - 1).min(prev.height() - 1))[x0..x0 + B];
-        let (Some(up), Some(mid), Some(down)) =
-            (patch.get((j - 1) * N..j * N), patch.get(j * N..(j + 1) * N), patch.get((j + 1) * N..(j + 2) * N))
-        else {
-            break;
-        };
-        for i in 0..B {
-            let gx = 0.5 * g * (mid[i + 2] - mid[i]);
-            let gy = 0.5 * g * (down[i + 1] - up[i + 1]);
-            let e = g * mid[i + 1] - prow[i] as f32;
-            acc[0][i] += gx * gx;
-            acc[1][i] += gx * gy;
-            acc[2][i] += gy * gy;
-            acc[3][i] += gx * e;
-            acc[4][i] += gy * e;
-        }
-    }
-    acc.map(|lanes| lanes.iter().map(|&v| v as f64).sum())
-}
-
-/// Sub-pixel flows of all textured windows between `prev` and `cur`.
-pub fn window_measurements(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &RobustConfig) -> Result<Vec<WindowMeasurement>> {
+    prev_smooth: &Plane<f32>,
+    cur_smooth: &Plane<f32>,
+    cfg: &RobustConfig,
+) -> Result<Vec<WindowMeasurement>> {
+    cfg.check()?;
+    ocellus_image::check::same_size("smoothed frame", prev_smooth.size(), prev.size())?;
+    ocellus_image::check::same_size("smoothed frame", cur_smooth.size(), cur.size())?;
     let windows = window_flows(prev, cur, &cfg.flow)?;
     let (cx, cy) = ((prev.width() as f64 - 1.0) / 2.0, (prev.height() as f64 - 1.0) / 2.0);
     // Brightness robustness: a global gain between the frames (exposure or lighting change),
     // the ratio of the mean grey levels of the searched region.
     let gain = region_mean(prev, cfg.flow.region) / region_mean(cur, cfg.flow.region).max(1e-9);
     let gain = if gain.is_finite() && gain > 0.0 { gain } else { 1.0 };
-    let b = cfg.flow.block as i64;
+    let b = cfg.lk_support;
     let half = (b as f64 - 1.0) / 2.0;
     let mut out = Vec::with_capacity(windows.len());
     let mut patch = Vec::new();
     for wf in &windows {
         let Some((fx, fy)) = wf.flow else { continue };
-        let (bx, by) = (wf.x - half, wf.y - half);
+        // The support's top-left pixel: the block's centre less half the support (an integer,
+        // support and block having the same parity).
+        let (bx, by) = ((wf.x - half).round().max(0.0) as usize, (wf.y - half).round().max(0.0) as usize);
         let (mut dx, mut dy) = (fx as f64, fy as f64);
         let mut tensor = [[0.0f64; 2]; 2];
+        let mut residual = 0.0;
         let mut ok = true;
         for _ in 0..cfg.lk_steps.max(1) {
-            let [a11, a12, a22, b1, b2] = lk_sums(prev, cur, bx, by, b as usize, dx, dy, gain, &mut patch);
+            let [a11, a12, a22, b1, b2, ee] = lk_sums(prev_smooth, cur_smooth, bx, by, b, dx, dy, gain, &mut patch);
             tensor = [[a11, a12], [a12, a22]];
             let det = a11 * a22 - a12 * a12;
-            let n = (b * b) as f64;
-            // Smaller eigenvalue per pixel: the texture across the weakest direction.
-            let tr = a11 + a22;
-            let lmin = 0.5 * (tr - ((a11 - a22).powi(2) + 4.0 * a12 * a12).sqrt()) / n;
-            if det.is_nan() || det <= 0.0 || lmin < cfg.min_texture {
+            if det.is_nan() || det <= 0.0 {
                 ok = false;
                 break;
             }
             let (sx, sy) = ((a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det);
+            // What the linearized step leaves of the squared differences.
+            residual = ee - (b1 * sx + b2 * sy);
             dx -= sx;
             dy -= sy;
             if (dx - fx as f64).abs() > 1.0 || (dy - fy as f64).abs() > 1.0 {
@@ -277,17 +198,27 @@ pub fn window_measurements(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &RobustConfig
                 break;
             }
         }
-        if ok {
-            // Noise of about 2 grey levels per pixel difference.
-            let s2 = 2.0 * 2.0 * 2.0;
-            out.push(WindowMeasurement {
-                u: wf.x - cx,
-                v: wf.y - cy,
-                du: dx,
-                dv: dy,
-                info: [[tensor[0][0] / s2, tensor[0][1] / s2], [tensor[1][0] / s2, tensor[1][1] / s2]],
-            });
+        if !ok {
+            continue;
         }
+        // The noise per pixel difference, from this window's own residual, and the flow's
+        // standard deviation across the weakest direction of the structure tensor: a window
+        // that cannot pin its flow to `max_flow_sigma_px` is dropped; the others weigh by
+        // their information, the tensor over the noise.
+        let n = (b * b) as f64;
+        let noise = (residual.max(0.0) / (n - 2.0).max(1.0)).max(MIN_NOISE_VAR);
+        let [[a11, a12], [_, a22]] = tensor;
+        let lmin = 0.5 * (a11 + a22 - ((a11 - a22).powi(2) + 4.0 * a12 * a12).sqrt());
+        if !(lmin > 0.0 && noise / lmin <= cfg.max_flow_sigma_px * cfg.max_flow_sigma_px) {
+            continue;
+        }
+        out.push(WindowMeasurement {
+            u: wf.x - cx,
+            v: wf.y - cy,
+            du: dx,
+            dv: dy,
+            info: [[a11 / noise, a12 / noise], [a12 / noise, a22 / noise]],
+        });
     }
     if out.len() < 3 {
         return Err(OdometryError::NoTexture(format!("only {} textured windows", out.len())));
@@ -410,6 +341,24 @@ pub fn fit_rigid(meas: &[WindowMeasurement], cfg: &RobustConfig) -> Result<Rigid
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bad_lucas_kanade_settings_are_refused() {
+        let ok = RobustConfig::default();
+        assert!(ok.check().is_ok());
+        for bad in [
+            RobustConfig { lk_support: 6, ..ok },
+            RobustConfig { lk_support: 15, ..ok },
+            RobustConfig { lk_support: 22, ..ok },
+            RobustConfig { smooth_sigma_px: f32::NAN, ..ok },
+            RobustConfig { smooth_sigma_px: -1.0, ..ok },
+            RobustConfig { max_flow_sigma_px: 0.0, ..ok },
+        ] {
+            assert!(bad.check().is_err(), "{bad:?}");
+            let f = Plane::from_fn(640, 480, |x, y| ((x * 7 + y * 13) % 256) as u8);
+            assert!(window_measurements(&f, &f, &bad).is_err());
+        }
+    }
 
     #[test]
     fn the_fit_inverts_the_model_exactly_and_resists_outliers() {

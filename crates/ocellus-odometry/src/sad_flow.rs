@@ -9,8 +9,12 @@
 //! `outlier_px` from the group's median are rejected and the rest averaged: one flow vector
 //! per group, at the mean position of its blocks.
 //!
-//! A window whose candidates all cost the same (a flat floor) has no flow; a frame where no
-//! group keeps a flow is reported as [`OdometryError::NoTexture`].
+//! A window whose candidates all cost the same (a flat floor) has no flow. Beyond the seed, a
+//! group keeps its flow only when at least `quorum` of its windows agree (5 of 9 by
+//! default): on a floor whose texture drowns in noise the integer matches scatter over the
+//! search range, their median is noise, and the seed's averaging would integrate it. A frame
+//! where no group keeps a flow is reported as [`OdometryError::NoTexture`], so the filter
+//! predicts it instead.
 
 use crate::{OdometryError, Result};
 use ocellus_image::{Backend, Plane};
@@ -29,15 +33,32 @@ pub struct SadFlowConfig {
     pub group: usize,
     /// Flows farther than this from their group's median (per axis) are outliers, pixels.
     pub outlier_px: f64,
+    /// Windows of a group that must agree (be inliers) for the group to give a flow, at
+    /// least 1 (1: the seed's rule, any window will do).
+    #[serde(default = "default_quorum")]
+    pub quorum: usize,
     /// Which build of the block search runs (`auto`: the fastest this CPU has).
     #[serde(default)]
     pub backend: Backend,
 }
 
+fn default_quorum() -> usize {
+    5
+}
+
 impl Default for SadFlowConfig {
-    /// 400x400 region, 20x20 windows, 8x8 blocks, 3x3 groups, outliers beyond 1 px.
+    /// 400x400 region, 20x20 windows, 8x8 blocks, 3x3 groups, outliers beyond 1 px, a group
+    /// counted when 5 of its windows agree.
     fn default() -> Self {
-        Self { region: 400, window: 20, block: 8, group: 3, outlier_px: 1.0, backend: Backend::Auto }
+        Self {
+            region: 400,
+            window: 20,
+            block: 8,
+            group: 3,
+            outlier_px: 1.0,
+            quorum: default_quorum(),
+            backend: Backend::Auto,
+        }
     }
 }
 
@@ -58,6 +79,13 @@ impl SadFlowConfig {
         }
         if !(self.outlier_px.is_finite() && self.outlier_px >= 0.0) {
             return Err(OdometryError::Invalid(format!("outlier threshold {}", self.outlier_px)));
+        }
+        if self.quorum == 0 || self.quorum > self.group * self.group {
+            return Err(OdometryError::Invalid(format!(
+                "quorum {}: between 1 and the {} windows of a group",
+                self.quorum,
+                self.group * self.group
+            )));
         }
         if w < self.region || h < self.region {
             return Err(OdometryError::TooSmall {
@@ -343,8 +371,8 @@ fn median(v: &mut [f64]) -> f64 {
 }
 
 /// The seed's 36 group flows: border windows dropped, groups of `group` x `group`, outliers
-/// beyond `outlier_px` of the group median rejected, the rest averaged. Groups without a
-/// flow are left out; no flow at all is [`OdometryError::NoTexture`].
+/// beyond `outlier_px` of the group median rejected, the rest averaged. Groups with fewer
+/// than `quorum` inliers are left out; no flow at all is [`OdometryError::NoTexture`].
 pub fn group_flows(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig) -> Result<Vec<FlowPoint>> {
     let windows = window_flows(prev, cur, cfg)?;
     let n = cfg.region / cfg.window;
@@ -382,14 +410,18 @@ pub fn group_flows(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &SadFlowConfig) -> Re
                     }
                 }
             }
-            if k > 0 {
+            if k >= cfg.quorum {
                 let kf = k as f64;
                 out.push(FlowPoint { u: su / kf - cx, v: sv / kf - cy, du: sx / kf, dv: sy / kf, inliers: k });
             }
         }
     }
     if out.is_empty() {
-        return Err(OdometryError::NoTexture("no search window found a unique best match".into()));
+        return Err(OdometryError::NoTexture(format!(
+            "no group of search windows agreed on a match ({} of {} needed)",
+            cfg.quorum,
+            cfg.group * cfg.group
+        )));
     }
     Ok(out)
 }
@@ -451,6 +483,26 @@ mod tests {
 
     fn flat_of(v: u8) -> Plane<u8> {
         Plane::from_fn(64, 48, |_, _| v)
+    }
+
+    #[test]
+    fn frames_of_unrelated_noise_fail_the_quorum() {
+        // Two frames with nothing in common: every window finds some best match, but they
+        // scatter, and no group of 9 has 5 that agree.
+        let (a, b) = (texture(640, 480, 11), texture(640, 480, 12));
+        let cfg = SadFlowConfig::default();
+        assert!(matches!(group_flows(&a, &b, &cfg), Err(OdometryError::NoTexture(_))));
+        // The seed's rule (any window will do) integrates them.
+        assert!(group_flows(&a, &b, &SadFlowConfig { quorum: 1, ..cfg }).is_ok());
+        // A real shift passes the quorum everywhere.
+        let shifted = Plane::from_fn(600, 440, |x, y| a.get(x + 3, y + 2));
+        let a0 = Plane::from_fn(600, 440, |x, y| a.get(x, y));
+        let flows = group_flows(&a0, &shifted, &cfg).unwrap();
+        assert_eq!(flows.len(), 36);
+        assert!(flows.iter().all(|f| f.du == -3.0 && f.dv == -2.0 && f.inliers == 9), "{flows:?}");
+        for q in [0, 10] {
+            assert!(group_flows(&a, &b, &SadFlowConfig { quorum: q, ..cfg }).is_err());
+        }
     }
 
     #[test]

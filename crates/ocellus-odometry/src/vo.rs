@@ -13,7 +13,8 @@
 //! robot's motion follows with the mount offset ([`crate::kinematics::robot_motion`]).
 
 use crate::kinematics::{moved_by_camera, robot_motion, Mount, Pose2};
-use crate::robust::{fit_rigid, window_measurements, RobustConfig};
+use crate::lucas_kanade::smooth;
+use crate::robust::{fit_rigid, window_measurements_smoothed, RobustConfig};
 use crate::sad_flow::{group_flows, FlowPoint, SadFlowConfig};
 use crate::{OdometryError, Result};
 use nalgebra::{Matrix3, Vector3};
@@ -76,6 +77,7 @@ impl OdometryConfig {
 
     fn check(&self) -> Result<()> {
         use ocellus_image::check;
+        self.robust.check()?;
         (|| {
             check::positive("camera height_m", self.height_m)?;
             check::positive("focal_px", self.focal_px)?;
@@ -110,6 +112,8 @@ pub struct OdometryStep {
 pub struct VisualOdometry {
     cfg: OdometryConfig,
     prev: Option<Plane<u8>>,
+    /// The previous frame smoothed for Lucas-Kanade (robust mode; each frame is smoothed once).
+    prev_smooth: Option<Plane<f32>>,
     x: Vector3<f64>,
     p: Matrix3<f64>,
     pose: Pose2,
@@ -126,7 +130,7 @@ impl VisualOdometry {
             (5.0 * px_m).powi(2),
             1f64.to_radians().powi(2),
         ));
-        Ok(Self { cfg, prev: None, x: Vector3::zeros(), p, pose: Pose2::default() })
+        Ok(Self { cfg, prev: None, prev_smooth: None, x: Vector3::zeros(), p, pose: Pose2::default() })
     }
 
     /// The current pose.
@@ -206,8 +210,15 @@ impl VisualOdometry {
 
     fn step_robust(&mut self, prev: &Plane<u8>, frame: &Plane<u8>) -> Result<OdometryStep> {
         let scale = self.cfg.height_m / self.cfg.focal_px;
-        let fit = window_measurements(prev, frame, &self.cfg.robust)
+        let sigma = self.cfg.robust.smooth_sigma_px;
+        let cur_smooth = smooth(frame, sigma)?;
+        let prev_smooth = match self.prev_smooth.take() {
+            Some(p) if p.size() == prev.size() => p,
+            _ => smooth(prev, sigma)?,
+        };
+        let fit = window_measurements_smoothed(prev, frame, &prev_smooth, &cur_smooth, &self.cfg.robust)
             .and_then(|m| fit_rigid(&m, &self.cfg.robust).map(|f| (f, m)));
+        self.prev_smooth = Some(cur_smooth);
         let (flows, failure, info_z, b) = match fit {
             Ok((f, m)) => {
                 // State (Tx, Ty, wz) = M (right_px, forward_px, turn), M = diag(-s, s, -1).
