@@ -70,6 +70,11 @@ pub struct GroundArgs {
     /// --real-camera. Range: 0..=0.95.
     #[arg(long, value_parser = ranges::within(0.0f32, 0.95))]
     vignetting: Option<f32>,
+    /// Rolling shutter: rows read from top to bottom over this fraction of the frame interval,
+    /// each row seen at its own pose (the frame's timestamp is the middle row's; 0: a global
+    /// shutter). Range: 0..=1.
+    #[arg(long, default_value_t = 0.0, value_parser = ranges::within(0.0f64, 1.0))]
+    rolling_shutter: f64,
     /// Output folder: frames/frame_NNNNN.png (or sequence.y4m), groundtruth.tum (the robot's
     /// rotation centre, metres), encoders.csv (30 Hz wheel odometry with slip events; the true
     /// slip per reading in encoder_slips.csv),
@@ -102,6 +107,7 @@ pub fn run(a: GroundArgs) -> Result<()> {
         supersample: a.supersample.unwrap_or(base.supersample),
         k1: a.k1.unwrap_or(base.k1),
         vignetting: a.vignetting.unwrap_or(base.vignetting),
+        rolling_shutter: a.rolling_shutter,
         ..base
     };
     let scene = GroundScene::new(cfg, textures()?)?;

@@ -20,6 +20,8 @@
 //!   about the image centre with focal [`FOCAL_PX`]: the frame is what the lens shows, and
 //!   the camera file carries `k1` for the odometry to undistort), and vignetting (brightness
 //!   falling as `1 - vignetting (r / r_corner)^2` from the centre to the corners).
+//! - **Rolling shutter** (off by default): rows read from top to bottom over a fraction of
+//!   the frame interval, each row seen at its own pose, which the planar model does not know.
 //! - **Hard variant:** motion blur (sub-frame renders over the exposure, centred on the frame
 //!   time, averaged), gain
 //!   flicker, a camera-height oscillation the planar model does not know, stronger noise.
@@ -124,6 +126,9 @@ pub struct GroundConfig {
     pub k1: f64,
     /// Brightness lost at the image corners, in [0, 1) (0: none; 0.3: corners at 70 %).
     pub vignetting: f32,
+    /// Rolling shutter: the rows are read from top to bottom over this fraction of the frame
+    /// interval, in [0, 1] (0: a global shutter). The frame's timestamp is the middle row's.
+    pub rolling_shutter: f64,
 }
 
 impl GroundConfig {
@@ -153,6 +158,7 @@ impl GroundConfig {
             supersample: 1,
             k1: 0.0,
             vignetting: 0.0,
+            rolling_shutter: 0.0,
         }
     }
 
@@ -208,11 +214,12 @@ impl GroundConfig {
             && self.k1.is_finite()
             && self.k1.abs() <= 0.5
             && self.vignetting.is_finite()
-            && (0.0..1.0).contains(&self.vignetting);
+            && (0.0..1.0).contains(&self.vignetting)
+            && (0.0..=1.0).contains(&self.rolling_shutter);
         if !usable {
             return bad(format!(
-                "supersample {} (1..=8), k1 {} ([-0.5, 0.5]), vignetting {} ([0, 1))",
-                self.supersample, self.k1, self.vignetting
+                "supersample {} (1..=8), k1 {} ([-0.5, 0.5]), vignetting {} ([0, 1)), rolling shutter {} ([0, 1])",
+                self.supersample, self.k1, self.vignetting, self.rolling_shutter
             ));
         }
         Ok(())
@@ -406,15 +413,25 @@ impl GroundScene {
         1.0 + self.cfg.height_oscillation * (std::f64::consts::TAU * t / 37.0).sin()
     }
 
-    /// Renders frame `k` (grey in [0, 1], before gain and noise) at the exact pose, no blur:
-    /// each pixel's sample rays (see [`sample_rays`]) on the floor, averaged and shaded.
-    fn render_at(&self, pose: &Pose2, scale: f64, out: &mut Plane<f32>, weight: f32) {
+    /// Adds `weight` times the view at time `t` (frames; grey in [0, 1], before gain and
+    /// noise) to `out`: each pixel's sample rays (see [`sample_rays`]) on the floor, averaged
+    /// and shaded. With a rolling shutter each row is seen at its own time, `t` being the
+    /// middle row's.
+    fn render_at(&self, t: f64, out: &mut Plane<f32>, weight: f32) {
         let (w, h) = (self.cfg.width, self.cfg.height);
         let n = self.cfg.supersample * self.cfg.supersample;
-        let cam = pose.point(self.cfg.mount_px[0], self.cfg.mount_px[1]);
-        let (r, f) = pose.axes();
+        let rs = self.cfg.rolling_shutter;
+        let view = |t: f64| {
+            let pose = self.pose_at(t);
+            (pose.point(self.cfg.mount_px[0], self.cfg.mount_px[1]), pose.axes(), self.scale(t))
+        };
+        let mut at = view(t);
         let mut cache = ((i64::MAX, i64::MAX), TileLook { texture: 0, rot: 0, flip: false });
         for v in 0..h {
+            if rs > 0.0 {
+                at = view(t + rs * (v as f64 / (h - 1).max(1) as f64 - 0.5));
+            }
+            let (cam, (r, f), scale) = at;
             let row = out.row_mut(v);
             for (u, o) in row.iter_mut().enumerate() {
                 let i = v * w + u;
@@ -456,7 +473,7 @@ impl GroundScene {
         for s in 0..n {
             let offset = if n > 1 { self.cfg.exposure * (s as f64 / (n - 1) as f64 - 0.5) } else { 0.0 };
             let t = k as f64 + offset;
-            self.render_at(&self.pose_at(t), self.scale(t), &mut acc, 1.0 / n as f32);
+            self.render_at(t, &mut acc, 1.0 / n as f32);
         }
         let mut rng = SplitMix64::new(self.cfg.seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ k as u64);
         let gain = 1.0 + self.cfg.gain_flicker * (2.0 * rng.unit() as f32 - 1.0);

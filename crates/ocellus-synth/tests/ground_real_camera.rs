@@ -123,3 +123,28 @@ fn unusable_real_camera_settings_are_refused() {
     }
     assert!(GroundScene::new(ok.real_camera(), textures()).is_ok());
 }
+
+#[test]
+fn a_rolling_shutter_shows_each_row_at_its_own_time() {
+    // Straight ahead at 2 px per frame, rows read over the whole frame interval: the top row
+    // is seen half a frame early, when the floor lay 1 px higher in the image (image y points
+    // backwards), the bottom row half a frame late, the middle row on time.
+    let still = GroundConfig {
+        height: 65,
+        forward_px: 2.0,
+        forward_spread_px: 0.0,
+        lateral_px: 0.0,
+        yaw_deg: 0.0,
+        yaw_spread_deg: 0.0,
+        ..small(GroundTexture::Gravel)
+    };
+    let global = GroundScene::new(still, textures()).unwrap().frame(5).unwrap();
+    let rolling =
+        GroundScene::new(GroundConfig { rolling_shutter: 1.0, ..still }, textures()).unwrap().frame(5).unwrap();
+    let close = |a: &[u8], b: &[u8]| a.iter().zip(b).all(|(p, q)| p.abs_diff(*q) <= 1);
+    assert!(close(rolling.row(32), global.row(32)));
+    assert!(close(rolling.row(0), global.row(1)));
+    assert!(close(rolling.row(64), global.row(63)));
+    assert!(!close(rolling.row(0), global.row(0)), "the top row moved");
+    assert!(GroundScene::new(GroundConfig { rolling_shutter: 1.5, ..still }, textures()).is_err());
+}
