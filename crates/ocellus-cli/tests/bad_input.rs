@@ -281,6 +281,8 @@ const CASES: &[Case] = &[
     c("synth ground --k1 NaN --out {O}", Usage(&["--k1", "range"])),
     c("synth ground --k1 -0.9 --out {O}", Usage(&["--k1", "range"])),
     c("synth ground --vignetting 1 --out {O}", Usage(&["--vignetting", "range"])),
+    c("synth ground --rolling-shutter 1.5 --out {O}", Usage(&["--rolling-shutter", "range"])),
+    c("synth ground --texture carpet --out {O}", Usage(&["--texture", "carpet"])),
     // ---- bench
     c("bench saliency --width 100000 --height 100000", Usage(&["--width", "range"])),
     c("bench saliency --height 0", Usage(&["--height", "range"])),
