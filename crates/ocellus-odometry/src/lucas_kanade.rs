@@ -80,20 +80,15 @@ pub(crate) fn lk_sums(
     patch.clear();
     let inside = fx >= 0.0 && fy >= 0.0 && fx as usize + n < cur.width() && fy as usize + n < cur.height();
     if inside {
-        // Each of the n + 1 source rows is interpolated along x once and shared by the two
-        // patch rows it touches.
         let (ix, iy) = (fx as usize, fy as usize);
-        let mut above: Vec<f32> = Vec::with_capacity(n);
-        let mut below: Vec<f32> = Vec::with_capacity(n);
-        let lerp_row = |row: &[f32], out: &mut Vec<f32>| {
-            out.clear();
-            out.extend(row.windows(2).map(|p| p[0] + ax * (p[1] - p[0])));
-        };
-        lerp_row(&cur.row(iy)[ix..ix + n + 1], &mut above);
+        // Along x, then y (the order of `at`), without scratch rows.
+        let lerp = |r: &[f32], i: usize| r[i] + ax * (r[i + 1] - r[i]);
         for j in 0..n {
-            lerp_row(&cur.row(iy + j + 1)[ix..ix + n + 1], &mut below);
-            patch.extend(above.iter().zip(&below).map(|(t, d)| t + ay * (d - t)));
-            std::mem::swap(&mut above, &mut below);
+            let (r0, r1) = (&cur.row(iy + j)[ix..ix + n + 1], &cur.row(iy + j + 1)[ix..ix + n + 1]);
+            patch.extend((0..n).map(|i| {
+                let (t, d) = (lerp(r0, i), lerp(r1, i));
+                t + ay * (d - t)
+            }));
         }
     } else {
         for j in 0..n {

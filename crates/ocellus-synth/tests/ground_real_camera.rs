@@ -18,6 +18,11 @@ fn textures() -> [Plane<f32>; 3] {
     })
 }
 
+/// A noiseless `width` x `height` sequence of two frames.
+fn two_frames(width: usize, height: usize, texture: GroundTexture, seed: u64) -> GroundConfig {
+    GroundConfig { width, height, frames: 2, noise_sigma: 0.0, ..GroundConfig::easy(texture, seed) }
+}
+
 fn small(texture: GroundTexture) -> GroundConfig {
     GroundConfig { width: 96, height: 64, frames: 30, noise_sigma: 0.0, ..GroundConfig::easy(texture, 3) }
 }
@@ -35,13 +40,7 @@ fn mean(p: &Plane<u8>, x0: usize, y0: usize, x1: usize, y1: usize) -> f64 {
 
 #[test]
 fn pixels_that_integrate_their_area_keep_the_brightness_and_lose_the_aliasing() {
-    let cfg = GroundConfig {
-        width: 160,
-        height: 120,
-        frames: 2,
-        noise_sigma: 0.0,
-        ..GroundConfig::easy(GroundTexture::Gravel, 1)
-    };
+    let cfg = two_frames(160, 120, GroundTexture::Gravel, 1);
     let point = GroundScene::new(cfg, photo_textures()).unwrap().frame(1).unwrap();
     let area = GroundScene::new(GroundConfig { supersample: 4, ..cfg }, photo_textures()).unwrap().frame(1).unwrap();
     let (mp, ma) = (mean(&point, 0, 0, 160, 120), mean(&area, 0, 0, 160, 120));
@@ -81,13 +80,7 @@ fn vignetting_darkens_the_corners_by_the_share_asked() {
 fn a_distorted_frame_undistorted_by_its_own_model_is_the_pinhole_frame() {
     use ocellus_geometry::camera::Intrinsics;
     use ocellus_geometry::distortion::{remap_bilinear, undistort_maps, Distortion};
-    let cfg = GroundConfig {
-        width: 320,
-        height: 240,
-        frames: 2,
-        noise_sigma: 0.0,
-        ..GroundConfig::easy(GroundTexture::Mosaic, 2)
-    };
+    let cfg = two_frames(320, 240, GroundTexture::Mosaic, 2);
     let pinhole = GroundScene::new(cfg, textures()).unwrap().frame(1).unwrap();
     let lens = GroundScene::new(GroundConfig { k1: -0.2, ..cfg }, textures()).unwrap().frame(1).unwrap();
     let k = Intrinsics { fx: FOCAL_PX, fy: FOCAL_PX, cx: 159.5, cy: 119.5, skew: 0.0 };
