@@ -376,16 +376,26 @@ pub fn gaussian_blur(backend: Backend, src: &Plane<f32>, sigma: f32) -> Result<P
     if !(sigma.is_finite() && sigma >= 0.0) {
         return Err(ImageError::InvalidParameter(format!("blur sigma {sigma} must be finite and >= 0")));
     }
-    if sigma < 0.3 {
+    let Some(k) = gaussian_kernel(sigma) else {
         return Ok(src.clone());
+    };
+    let mut out = Plane::default();
+    sep_filter(backend, src, &mut out, &k, &k, Border::Clamp, &mut FilterScratch::default())?;
+    Ok(out)
+}
+
+/// The taps of [`gaussian_blur`]'s kernel for `sigma` (pixels): half-width `ceil(3 sigma)`,
+/// summing to 1; `None` below 0.3 px, where the blur is a copy (and for a sigma that is not
+/// finite and >= 0).
+pub fn gaussian_kernel(sigma: f32) -> Option<Vec<f32>> {
+    if !(sigma.is_finite() && sigma >= 0.3) {
+        return None;
     }
     let hw = (3.0 * sigma).ceil() as i32;
     let mut k: Vec<f32> = (-hw..=hw).map(|i| (-(i * i) as f32 / (2.0 * sigma * sigma)).exp()).collect();
     let s: f32 = k.iter().sum();
     k.iter_mut().for_each(|v| *v /= s);
-    let mut out = Plane::default();
-    sep_filter(backend, src, &mut out, &k, &k, Border::Clamp, &mut FilterScratch::default())?;
-    Ok(out)
+    Some(k)
 }
 
 /// Direct 2D correlation (slow reference): `out(x,y) = sum k(i,j) in(x+i-hw, y+j-hh)`.

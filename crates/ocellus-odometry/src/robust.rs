@@ -22,7 +22,7 @@
 //! `r` to the right and `f` forward and turns clockwise by `w`): a floor point at (u, v) in
 //! frame n-1 is seen at `u' = (u - r) cos w + (v + f) sin w`, `v' = -(u - r) sin w + (v + f) cos w`.
 
-use crate::lucas_kanade::{lk_sums, smooth, DEFAULT_SMOOTH_SIGMA_PX};
+use crate::lucas_kanade::{lk_sums, SmoothedFrame, DEFAULT_SMOOTH_SIGMA_PX};
 use crate::sad_flow::{window_flows, SadFlowConfig};
 use crate::{OdometryError, Result};
 use nalgebra::{Matrix3, Matrix4, Vector4};
@@ -141,26 +141,63 @@ fn region_mean(img: &Plane<u8>, region: usize) -> f64 {
     s as f64 / n.max(1) as f64
 }
 
+/// The rectangle `[x0, y0, x1, y1]` (end exclusive) of a `w` x `h` frame that Lucas-Kanade
+/// reads with `cfg`: the searched region, grown by what the support adds beyond the block and
+/// by the largest flow's reach (the search margin, one Lucas-Kanade pixel, the patch border
+/// and bilinear neighbour; worked out in a comment inside). Errors as the search does for a
+/// frame smaller than the region or a bad configuration.
+pub fn lk_rect(w: usize, h: usize, cfg: &RobustConfig) -> Result<[usize; 4]> {
+    cfg.check()?;
+    cfg.flow.check(w, h)?;
+    // A window's Lucas-Kanade square starts (support - block) / 2 left of its block, which
+    // starts the search margin m right of the window. The flow is within m + 1 px of zero, and
+    // the patch adds a border pixel and a bilinear neighbour: reads reach from
+    // x0 - (support - block) / 2 - 2 to x0 + region + (support - block) / 2 + 2, inclusive.
+    let grow = (cfg.lk_support - cfg.flow.block) / 2 + 3;
+    let (x0, y0) = ((w - cfg.flow.region) / 2, (h - cfg.flow.region) / 2);
+    Ok([
+        x0.saturating_sub(grow),
+        y0.saturating_sub(grow),
+        (x0 + cfg.flow.region + grow).min(w),
+        (y0 + cfg.flow.region + grow).min(h),
+    ])
+}
+
 /// Sub-pixel flows of all textured windows between `prev` and `cur` (smoothing both for
 /// Lucas-Kanade, see [`crate::lucas_kanade`]).
 pub fn window_measurements(prev: &Plane<u8>, cur: &Plane<u8>, cfg: &RobustConfig) -> Result<Vec<WindowMeasurement>> {
-    let (ps, cs) = (smooth(prev, cfg.smooth_sigma_px)?, smooth(cur, cfg.smooth_sigma_px)?);
+    let rect = lk_rect(prev.width(), prev.height(), cfg)?;
+    let (mut ps, mut cs) = (SmoothedFrame::default(), SmoothedFrame::default());
+    ps.update(cfg.flow.backend, prev, cfg.smooth_sigma_px, rect)?;
+    cs.update(cfg.flow.backend, cur, cfg.smooth_sigma_px, rect)?;
     window_measurements_smoothed(prev, cur, &ps, &cs, cfg)
 }
 
 /// [`window_measurements`] with both frames already smoothed for Lucas-Kanade
-/// ([`crate::lucas_kanade::smooth`] with `cfg.smooth_sigma_px`; a stream smooths each frame
-/// once).
+/// ([`SmoothedFrame::update`] with `cfg.smooth_sigma_px` over at least [`lk_rect`]; a stream
+/// smooths each frame once).
 pub fn window_measurements_smoothed(
     prev: &Plane<u8>,
     cur: &Plane<u8>,
-    prev_smooth: &Plane<f32>,
-    cur_smooth: &Plane<f32>,
+    prev_smooth: &SmoothedFrame,
+    cur_smooth: &SmoothedFrame,
     cfg: &RobustConfig,
 ) -> Result<Vec<WindowMeasurement>> {
-    cfg.check()?;
-    ocellus_image::check::same_size("smoothed frame", prev_smooth.size(), prev.size())?;
-    ocellus_image::check::same_size("smoothed frame", cur_smooth.size(), cur.size())?;
+    let [x0, y0, x1, y1] = lk_rect(prev.width(), prev.height(), cfg)?;
+    for s in [prev_smooth, cur_smooth] {
+        ocellus_image::check::same_size("smoothed frame", s.frame_size(), prev.size())?;
+        let (ox, oy) = s.origin();
+        let (sw, sh) = s.plane().size();
+        if ox > x0 || oy > y0 || ox + sw < x1 || oy + sh < y1 {
+            return Err(OdometryError::Invalid(format!(
+                "the smoothed part of the frame ({sw}x{sh} at {ox},{oy}) does not cover what Lucas-Kanade reads ({x0}..{x1} x {y0}..{y1})"
+            )));
+        }
+    }
+    if prev_smooth.origin() != cur_smooth.origin() {
+        return Err(OdometryError::Invalid("the two frames were smoothed over different parts".into()));
+    }
+    let (ox, oy) = prev_smooth.origin();
     let windows = window_flows(prev, cur, &cfg.flow)?;
     let (cx, cy) = ((prev.width() as f64 - 1.0) / 2.0, (prev.height() as f64 - 1.0) / 2.0);
     // Brightness robustness: a global gain between the frames (exposure or lighting change),
@@ -181,7 +218,18 @@ pub fn window_measurements_smoothed(
         let mut residual = 0.0;
         let mut ok = true;
         for _ in 0..cfg.lk_steps.max(1) {
-            let [a11, a12, a22, b1, b2, ee] = lk_sums(prev_smooth, cur_smooth, bx, by, b, dx, dy, gain, &mut patch);
+            let [a11, a12, a22, b1, b2, ee] = lk_sums(
+                cfg.flow.backend,
+                prev_smooth.plane(),
+                cur_smooth.plane(),
+                bx.saturating_sub(ox),
+                by.saturating_sub(oy),
+                b,
+                dx,
+                dy,
+                gain,
+                &mut patch,
+            );
             tensor = [[a11, a12], [a12, a22]];
             let det = a11 * a22 - a12 * a12;
             if det.is_nan() || det <= 0.0 {

@@ -63,7 +63,7 @@ impl Default for SadFlowConfig {
 }
 
 impl SadFlowConfig {
-    fn check(&self, w: usize, h: usize) -> Result<usize> {
+    pub(crate) fn check(&self, w: usize, h: usize) -> Result<usize> {
         if self.block == 0 || self.block >= self.window || (self.window - self.block) % 2 != 0 {
             return Err(OdometryError::Invalid(format!(
                 "block {} in window {}: the block must be smaller, with an even margin",

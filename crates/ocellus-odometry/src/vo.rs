@@ -13,8 +13,8 @@
 //! robot's motion follows with the mount offset ([`crate::kinematics::robot_motion`]).
 
 use crate::kinematics::{moved_by_camera, robot_motion, Mount, Pose2};
-use crate::lucas_kanade::smooth;
-use crate::robust::{fit_rigid, window_measurements_smoothed, RobustConfig};
+use crate::lucas_kanade::SmoothedFrame;
+use crate::robust::{fit_rigid, lk_rect, window_measurements_smoothed, RobustConfig};
 use crate::sad_flow::{group_flows, FlowPoint, SadFlowConfig};
 use crate::{OdometryError, Result};
 use nalgebra::{Matrix3, Vector3};
@@ -112,8 +112,12 @@ pub struct OdometryStep {
 pub struct VisualOdometry {
     cfg: OdometryConfig,
     prev: Option<Plane<u8>>,
-    /// The previous frame smoothed for Lucas-Kanade (robust mode; each frame is smoothed once).
-    prev_smooth: Option<Plane<f32>>,
+    /// The previous frame smoothed for Lucas-Kanade (robust mode; each frame is smoothed once),
+    /// when it is the previous frame's.
+    prev_smooth: SmoothedFrame,
+    prev_smooth_valid: bool,
+    /// The buffers the current frame is smoothed into (swapped with `prev_smooth`).
+    cur_smooth: SmoothedFrame,
     x: Vector3<f64>,
     p: Matrix3<f64>,
     pose: Pose2,
@@ -130,7 +134,16 @@ impl VisualOdometry {
             (5.0 * px_m).powi(2),
             1f64.to_radians().powi(2),
         ));
-        Ok(Self { cfg, prev: None, prev_smooth: None, x: Vector3::zeros(), p, pose: Pose2::default() })
+        Ok(Self {
+            cfg,
+            prev: None,
+            prev_smooth: SmoothedFrame::default(),
+            prev_smooth_valid: false,
+            cur_smooth: SmoothedFrame::default(),
+            x: Vector3::zeros(),
+            p,
+            pose: Pose2::default(),
+        })
     }
 
     /// The current pose.
@@ -154,10 +167,15 @@ impl VisualOdometry {
                 failure: None,
             });
         };
-        if self.cfg.mode == Mode::Robust {
-            return self.step_robust(&prev, frame);
+        match self.cfg.mode {
+            Mode::Robust => self.step_robust(&prev, frame),
+            Mode::Seed => self.step_seed(&prev, frame),
         }
-        let (flows, failure) = match group_flows(&prev, frame, &self.cfg.flow) {
+    }
+
+    /// The seed's step (SPEC 6.2-6.3) from `prev` to `frame`.
+    fn step_seed(&mut self, prev: &Plane<u8>, frame: &Plane<u8>) -> Result<OdometryStep> {
+        let (flows, failure) = match group_flows(prev, frame, &self.cfg.flow) {
             Ok(f) => (f, None),
             Err(OdometryError::NoTexture(why)) => (Vec::new(), Some(why)),
             Err(e) => return Err(e),
@@ -211,14 +229,19 @@ impl VisualOdometry {
     fn step_robust(&mut self, prev: &Plane<u8>, frame: &Plane<u8>) -> Result<OdometryStep> {
         let scale = self.cfg.height_m / self.cfg.focal_px;
         let sigma = self.cfg.robust.smooth_sigma_px;
-        let cur_smooth = smooth(frame, sigma)?;
-        let prev_smooth = match self.prev_smooth.take() {
-            Some(p) if p.size() == prev.size() => p,
-            _ => smooth(prev, sigma)?,
-        };
-        let fit = window_measurements_smoothed(prev, frame, &prev_smooth, &cur_smooth, &self.cfg.robust)
+        let backend = self.cfg.robust.flow.backend;
+        // Valid again only once this frame's smoothing is in place (an error below leaves it so).
+        let prev_valid = std::mem::replace(&mut self.prev_smooth_valid, false);
+        ocellus_image::check::same_size("frame (against the previous one)", frame.size(), prev.size())?;
+        let rect = lk_rect(frame.width(), frame.height(), &self.cfg.robust)?;
+        self.cur_smooth.update(backend, frame, sigma, rect)?;
+        if !prev_valid {
+            self.prev_smooth.update(backend, prev, sigma, rect)?;
+        }
+        let fit = window_measurements_smoothed(prev, frame, &self.prev_smooth, &self.cur_smooth, &self.cfg.robust)
             .and_then(|m| fit_rigid(&m, &self.cfg.robust).map(|f| (f, m)));
-        self.prev_smooth = Some(cur_smooth);
+        std::mem::swap(&mut self.prev_smooth, &mut self.cur_smooth);
+        self.prev_smooth_valid = true;
         let (flows, failure, info_z, b) = match fit {
             Ok((f, m)) => {
                 // State (Tx, Ty, wz) = M (right_px, forward_px, turn), M = diag(-s, s, -1).

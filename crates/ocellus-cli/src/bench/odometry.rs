@@ -26,7 +26,8 @@ pub fn run(json_out: bool, backend: Backend) -> Result<()> {
     let mut t_robust = Vec::new();
     for _ in 0..3 {
         let mut cfg = OdometryConfig::robust(0.3, 600.0, Mount { right_m: 0.0, forward_m: 0.05 });
-        cfg.flow.backend = backend;
+        // The robust mode searches with its own flow settings.
+        cfg.robust.flow.backend = backend;
         let mut vo = VisualOdometry::new(cfg)?;
         for f in &frames {
             let t = Instant::now();
