@@ -126,7 +126,8 @@ impl Odometry {
 
     /// One frame (uint8 H x W, or float32 in grey levels 0..255): {"pose": (x, y, theta),
     /// "camera_motion": (right, forward, turn), "camera_motion_sigma", "failure" (None, or
-    /// why the motion was predicted instead of measured)}.
+    /// why the motion was predicted instead of measured), "height_m" (the camera height
+    /// followed in robust mode)}.
     fn step<'py>(&mut self, py: Python<'py>, frame: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
         let grey: Plane<u8> = match frame.extract::<PyReadonlyArrayDyn<'_, u8>>() {
             Ok(a) => {
@@ -146,6 +147,7 @@ impl Odometry {
         d.set_item("camera_motion", s.camera_motion.to_vec())?;
         d.set_item("camera_motion_sigma", s.camera_motion_sigma.to_vec())?;
         d.set_item("failure", s.failure)?;
+        d.set_item("height_m", s.height_m)?;
         Ok(d)
     }
 

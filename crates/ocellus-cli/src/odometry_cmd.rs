@@ -46,6 +46,11 @@ pub struct OdometryArgs {
     /// windows) or `seed` (the seed's integer SAD groups and filter).
     #[arg(long, value_enum, default_value = "robust")]
     mode: Mode,
+    /// Robust mode: how much of its offset from the calibrated camera height the height
+    /// followed through the image's scale change loses per frame (0: pure integration; 1: the
+    /// height stays at the calibrated value, the seed's assumption). Range: 0..=1.
+    #[arg(long, default_value_t = 0.002, value_parser = ranges::within(0.0f64, 1.0))]
+    height_pull: f64,
     /// Frame rate, Hz (timestamps of the trajectory). Range: above 0, at most 1000000.
     #[arg(long, default_value_t = 200.0, value_parser = ranges::above(0.0f64, 1e6))]
     rate_hz: f64,
@@ -117,10 +122,11 @@ pub fn run(a: OdometryArgs) -> Result<()> {
         forward_m: a.mount_forward_m.or(cam.mount_forward_m).unwrap_or(0.0),
     };
     let focal = 0.5 * (cam.intrinsics.fx + cam.intrinsics.fy);
-    let cfg = match a.mode {
+    let mut cfg = match a.mode {
         Mode::Seed => OdometryConfig::seed(height, focal, mount),
         Mode::Robust => OdometryConfig::robust(height, focal, mount),
     };
+    cfg.robust.height_pull = a.height_pull;
     let mut vo = VisualOdometry::new(cfg)?;
     let readings: Option<Vec<EncoderReading>> = match &a.encoders {
         Some(p) => {

@@ -105,6 +105,9 @@ pub struct OdometryStep {
     pub flows: Vec<FlowPoint>,
     /// Why no measurement was used (the motion was then predicted), if so.
     pub failure: Option<String>,
+    /// The camera height at this frame, metres: the calibrated one, or in robust mode the
+    /// one followed through the image-scale change (see [`RobustConfig::height_pull`]).
+    pub height_m: f64,
 }
 
 /// The seed's visual odometry over a frame stream.
@@ -121,6 +124,8 @@ pub struct VisualOdometry {
     x: Vector3<f64>,
     p: Matrix3<f64>,
     pose: Pose2,
+    /// The followed camera height over the calibrated one (robust mode; 1 in seed mode).
+    height_ratio: f64,
 }
 
 impl VisualOdometry {
@@ -143,6 +148,7 @@ impl VisualOdometry {
             x: Vector3::zeros(),
             p,
             pose: Pose2::default(),
+            height_ratio: 1.0,
         })
     }
 
@@ -165,6 +171,7 @@ impl VisualOdometry {
                 camera_motion_sigma: [0.0; 3],
                 flows: Vec::new(),
                 failure: None,
+                height_m: self.cfg.height_m * self.height_ratio,
             });
         };
         match self.cfg.mode {
@@ -223,11 +230,13 @@ impl VisualOdometry {
             camera_motion_sigma: self.sigma(),
             flows,
             failure,
+            height_m: self.cfg.height_m * self.height_ratio,
         }
     }
 
     fn step_robust(&mut self, prev: &Plane<u8>, frame: &Plane<u8>) -> Result<OdometryStep> {
-        let scale = self.cfg.height_m / self.cfg.focal_px;
+        // The translation is measured in frame n-1's pixels, at frame n-1's height.
+        let scale = self.cfg.height_m * self.height_ratio / self.cfg.focal_px;
         let sigma = self.cfg.robust.smooth_sigma_px;
         let backend = self.cfg.robust.flow.backend;
         // Valid again only once this frame's smoothing is in place (an error below leaves it so).
@@ -244,6 +253,12 @@ impl VisualOdometry {
         self.prev_smooth_valid = true;
         let (flows, failure, info_z, b) = match fit {
             Ok((f, m)) => {
+                // Frame n is frame n-1 magnified by 1 + k: the camera came down by 1 / (1 + k).
+                // A change beyond 20 % in one frame is not a height change the floor allows.
+                if f.scale_change.is_finite() && f.scale_change.abs() < 0.2 {
+                    let pull = self.cfg.robust.height_pull;
+                    self.height_ratio = 1.0 + (self.height_ratio / (1.0 + f.scale_change) - 1.0) * (1.0 - pull);
+                }
                 // State (Tx, Ty, wz) = M (right_px, forward_px, turn), M = diag(-s, s, -1).
                 let z = Vector3::new(-scale * f.right_px, scale * f.forward_px, -f.turn_rad);
                 let m_inv = Matrix3::from_diagonal(&Vector3::new(-1.0 / scale, 1.0 / scale, -1.0));

@@ -61,6 +61,46 @@ fn robust_mode_stays_within_a_tenth_of_a_percent_on_brick_and_gravel() {
 }
 
 #[test]
+fn the_robust_mode_follows_the_camera_height() {
+    // The hard variant's camera height oscillates by 1 % over 37 frames (image scale
+    // 1 + 0.01 sin(2 pi t / 37), the generator's documented model); here without noise, blur
+    // or flicker, so the height is the only thing wrong with a fixed-height model.
+    let cfg = GroundConfig { frames: 120, height_oscillation: 0.01, ..GroundConfig::easy(GroundTexture::Gravel, 1) };
+    let scene = GroundScene::new(cfg, textures()).unwrap();
+    let mut vo_cfg = OdometryConfig::robust(0.3, 600.0, Mount { right_m: 0.0, forward_m: 0.0 });
+    vo_cfg.robust.height_pull = 0.0;
+    let mut vo = VisualOdometry::new(vo_cfg).unwrap();
+    let mut worst = 0.0f64;
+    for k in 0..scene.len() {
+        let step = vo.step(&scene.frame(k).unwrap()).unwrap();
+        let truth = 0.3 * (1.0 + 0.01 * (std::f64::consts::TAU * k as f64 / 37.0).sin());
+        worst = worst.max((step.height_m - truth).abs());
+    }
+    println!("height followed within {:.4} mm of the truth (oscillation 3 mm)", worst * 1e3);
+    assert!(worst < 0.2e-3, "height error {worst} m");
+    // Followed (the default pull) against fixed at the calibrated height: less drift.
+    let drift = |pull: f64| {
+        let c = scene.config();
+        let mount = Mount { right_m: c.mount_px[0] * c.metres_per_px, forward_m: c.mount_px[1] * c.metres_per_px };
+        let mut vo_cfg = OdometryConfig::robust(0.3, 600.0, mount);
+        vo_cfg.robust.height_pull = pull;
+        let mut vo = VisualOdometry::new(vo_cfg).unwrap();
+        let mut truth = Vec::new();
+        for k in 0..scene.len() {
+            vo.step(&scene.frame(k).unwrap()).unwrap();
+            let (x, y, yaw) = scene.pose_m(k).unwrap();
+            truth.push(PlanarPose::new(k as f64, x, y, yaw));
+        }
+        let (e, end) = (vo.pose(), truth[truth.len() - 1]);
+        final_drift(&PlanarPose::new(end.time_s, e.x, e.y, e.theta), &end, path_length(&truth)).unwrap().0
+    };
+    let (followed, fixed) =
+        (drift(OdometryConfig::robust(0.3, 600.0, Mount::default()).robust.height_pull), drift(1.0));
+    println!("drift with the height followed {followed:.4} %, fixed {fixed:.4} %");
+    assert!(followed < 0.85 * fixed, "followed {followed} %, fixed {fixed} %");
+}
+
+#[test]
 fn robust_mode_holds_on_low_contrast_fine_grained_and_repetitive_floors_seen_by_a_real_camera() {
     // Before Lucas-Kanade ran on smoothed frames with a noise-relative texture test, these
     // drifted 0.07-0.15 % (seed 1, 200 frames): bilinear interpolation pulled every flow
