@@ -22,15 +22,20 @@ import ray_saliency  # noqa: E402
 def test_ray_example_equals_direct_calls(tmp_path):
     stimuli = TESTDATA / "mit1003" / "stimuli"
     fixations = TESTDATA / "mit1003" / "fixation_maps"
-    out = tmp_path / "scores"
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     try:
-        ray_saliency.run(str(stimuli), str(out), fixations=str(fixations), workers=2)
+        # Decoded in the workers, and in Ray's reader: the same rows.
+        for decode in ("worker", "reader"):
+            ray_saliency.run(str(stimuli), str(tmp_path / decode), fixations=str(fixations), workers=2, decode=decode)
+        with pytest.raises(ValueError):
+            ray_saliency.run(str(stimuli), str(tmp_path / "x"), workers=1, decode="gpu")
     finally:
         ray.shutdown()
     import pyarrow.parquet as pq
 
-    table = pq.read_table(out).to_pylist()
+    by_path = lambda t: sorted(t, key=lambda r: r["path"])  # noqa: E731
+    table = by_path(pq.read_table(tmp_path / "worker").to_pylist())
+    assert table == by_path(pq.read_table(tmp_path / "reader").to_pylist())
     paths = sorted(stimuli.iterdir())
     assert sorted(pathlib.Path(r["path"]).name for r in table) == [p.name for p in paths]
     for r in table:
