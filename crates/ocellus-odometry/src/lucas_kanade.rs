@@ -119,9 +119,9 @@ fn floor(x: f64) -> f64 {
     }
 }
 
-/// Lanes of the sums: the pixels of a row are summed in this many independent lanes, which
-/// the compiler keeps in vector registers (one sum per lane would be a serial chain of adds,
-/// which it may not reorder).
+/// Lanes of the sums: the pixels are summed in this many independent running sums, which the
+/// compiler keeps in one vector register each (a single running sum is a serial chain of adds
+/// that it may not reorder, so it stays scalar).
 const LANES: usize = 8;
 
 ocellus_image::dispatch_kernel!(
