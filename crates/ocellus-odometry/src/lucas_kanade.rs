@@ -18,23 +18,14 @@
 
 use crate::{OdometryError, Result};
 use ocellus_image::filter::{gaussian_kernel, sep_filter, Border, FilterScratch};
+use ocellus_image::resample::sample_bilinear;
 use ocellus_image::simd::Madd;
 use ocellus_image::{Backend, Plane};
 
 /// Default sigma of the smoothing before Lucas-Kanade, pixels.
 pub const DEFAULT_SMOOTH_SIGMA_PX: f32 = 1.5;
 
-/// `frame` in f32 grey levels, smoothed by a Gaussian of `sigma_px` (0: converted only).
-pub fn smooth(frame: &Plane<u8>, sigma_px: f32) -> Result<Plane<f32>> {
-    let f = frame.map(f32::from);
-    if sigma_px == 0.0 {
-        return Ok(f);
-    }
-    ocellus_image::filter::gaussian_blur(Backend::Auto, &f, sigma_px)
-        .map_err(|e| OdometryError::Invalid(format!("smoothing sigma {sigma_px}: {e}")))
-}
-
-/// A frame smoothed as [`smooth`] does, over the part of it that Lucas-Kanade reads: a
+/// A frame in f32 grey levels smoothed by a Gaussian, over the part of it that Lucas-Kanade reads: a
 /// rectangle of the frame plus the kernel's half-width, so that inside the rectangle the values
 /// are those of the whole frame smoothed (the filter's border rule only acts where the
 /// rectangle meets the frame's edge). Why not the whole frame: the windows cover the central
@@ -51,7 +42,8 @@ pub struct SmoothedFrame {
 
 impl SmoothedFrame {
     /// Smooths `rect` = `[x0, y0, x1, y1]` (frame pixels, end exclusive) of `frame` by a
-    /// Gaussian of `sigma_px` (below 0.3 px: converted only, as [`smooth`]).
+    /// Gaussian of `sigma_px` ([`ocellus_image::filter::gaussian_blur`]'s kernel; below 0.3 px:
+    /// converted only).
     pub fn update(&mut self, backend: Backend, frame: &Plane<u8>, sigma_px: f32, rect: [usize; 4]) -> Result<()> {
         let (w, h) = frame.size();
         let [x0, y0, x1, y1] = rect;
@@ -94,18 +86,6 @@ impl SmoothedFrame {
     pub fn frame_size(&self) -> (usize, usize) {
         self.frame_size
     }
-}
-
-/// Bilinear sample with clamping.
-fn at(img: &Plane<f32>, x: f64, y: f64) -> f32 {
-    let (w, h) = (img.width() as f64, img.height() as f64);
-    let (x, y) = (x.clamp(0.0, w - 1.0), y.clamp(0.0, h - 1.0));
-    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-    let (x1, y1) = ((x0 + 1).min(img.width() - 1), (y0 + 1).min(img.height() - 1));
-    let (ax, ay) = ((x - x0 as f64) as f32, (y - y0 as f64) as f32);
-    let top = img.get(x0, y0) + ax * (img.get(x1, y0) - img.get(x0, y0));
-    let bot = img.get(x0, y1) + ax * (img.get(x1, y1) - img.get(x0, y1));
-    top + ay * (bot - top)
 }
 
 /// `x.floor()` without the library call that baseline x86-64 (no SSE4.1 `roundsd`) makes for
@@ -181,7 +161,7 @@ fn lk_sums_generic<M: Madd>(
     } else {
         for (j, out) in patch.chunks_exact_mut(n).enumerate() {
             for (i, o) in out.iter_mut().enumerate() {
-                *o = g * at(cur, sx + i as f64, sy + j as f64);
+                *o = g * sample_bilinear(cur, (sx + i as f64) as f32, (sy + j as f64) as f32);
             }
         }
     }
@@ -249,7 +229,7 @@ mod tests {
             for j in 0..b {
                 for i in 0..b {
                     let (x, y) = ((bx + i) as f64 + dx, (by + j) as f64 + dy);
-                    let c = |x: f64, y: f64| 1.1 * at(&cur, x, y) as f64;
+                    let c = |x: f64, y: f64| 1.1 * sample_bilinear(&cur, x as f32, y as f32) as f64;
                     let gx = 0.5 * (c(x + 1.0, y) - c(x - 1.0, y));
                     let gy = 0.5 * (c(x, y + 1.0) - c(x, y - 1.0));
                     let e = c(x, y) - img.get(bx + i, by + j) as f64;
@@ -270,7 +250,7 @@ mod tests {
     #[test]
     fn a_smoothed_rectangle_is_the_whole_frame_smoothed_there() {
         let f = Plane::from_fn(90, 70, |x, y| ((x * 37 + y * 101 + x * y) % 251) as u8);
-        let whole = smooth(&f, 1.5).unwrap();
+        let whole = ocellus_image::filter::gaussian_blur(Backend::Auto, &f.map(f32::from), 1.5).unwrap();
         let mut part = SmoothedFrame::default();
         // Inside the frame, and against its edges (where both clamp).
         for rect in [[20, 15, 60, 50], [0, 0, 30, 25], [70, 40, 90, 70]] {
@@ -295,11 +275,15 @@ mod tests {
     #[test]
     fn smoothing_keeps_the_mean_and_zero_is_a_copy() {
         let f = Plane::from_fn(40, 30, |x, y| ((x * 7 + y * 13) % 256) as u8);
-        let s0 = smooth(&f, 0.0).unwrap();
+        let smooth = |sigma: f32| {
+            let mut s = SmoothedFrame::default();
+            s.update(Backend::Auto, &f, sigma, [0, 0, 40, 30]).map(|_| s.plane().clone())
+        };
+        let s0 = smooth(0.0).unwrap();
         assert_eq!(s0.get(5, 7), f.get(5, 7) as f32);
-        let s = smooth(&f, 1.0).unwrap();
+        let s = smooth(1.0).unwrap();
         let mean = |p: &Plane<f32>| p.rows().flatten().sum::<f32>() / (40.0 * 30.0);
         assert!((mean(&s) - mean(&s0)).abs() < 1.0);
-        assert!(smooth(&f, f32::NAN).is_err());
+        assert!(smooth(f32::NAN).is_err());
     }
 }
