@@ -9,7 +9,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use ocellus_image::Plane;
 use ocellus_retina::action::{Action, ActionKinds, MotorCode};
-use ocellus_retina::experiment::{setup, start, ExperimentConfig, Init, Setup};
+use ocellus_retina::experiment::{setup, start, ExperimentConfig, Init, MotorSpace, Setup};
 use ocellus_retina::layout::{measure, Layout};
 use ocellus_retina::model::{Free, Objective, Params};
 use ocellus_retina::picture;
@@ -38,6 +38,15 @@ enum ActionsArg {
     Translation,
     RotationDilation,
     All,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
+enum MotorSpaceArg {
+    /// Each fixed motor field is a cell of a grid tiling the 2D motor space (60: 10 x 6), its
+    /// triplets' actions drawn anywhere inside it.
+    Cells,
+    /// Each fixed motor field is one exact action value on the two axes.
+    Values,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum, PartialEq, Eq)]
@@ -73,6 +82,10 @@ struct LearnArgs {
     /// rotation-dilation].
     #[arg(long, value_enum, default_value = "rotation-dilation")]
     actions: ActionsArg,
+    /// Experiment 1: what each fixed motor field stands for [default: cells; values with
+    /// `--actions all`, which has no 2D motor space to tile].
+    #[arg(long, value_enum)]
+    motor_space: Option<MotorSpaceArg>,
     /// Solver.
     #[arg(long, value_enum, default_value = "auto")]
     solver: SolverArg,
@@ -186,15 +199,22 @@ fn learn(a: LearnArgs) -> Result<()> {
     cfg.blur_px = a.blur;
     cfg.action_scale = a.action_scale;
     cfg.motor_smoothness = a.motor_smoothness;
+    match (a.motor_space, cfg.experiment) {
+        (Some(MotorSpaceArg::Cells), 1) => cfg.motor_space = MotorSpace::Cells,
+        (Some(MotorSpaceArg::Values), 1) => cfg.motor_space = MotorSpace::Values,
+        (Some(_), _) => bail!("--motor-space is for experiment 1 (experiment 2 learns its motor fields)"),
+        (None, _) => {}
+    }
     cfg.validate()?;
     let src = sources(a.images.as_deref())?;
     outln!(
-        "experiment {}: {} pixels, {} receptive fields, {} motor fields over {} motor cells, {} actions; {} variables",
+        "experiment {}: {} pixels, {} receptive fields, {} motor fields over {} motor cells{}, {} actions; {} variables",
         cfg.experiment,
         cfg.pixels,
         cfg.fields,
         cfg.motor_fields,
         cfg.shape().motor_cells,
+        if cfg.experiment == 1 { format!(" (as {})", cfg.motor_space.name()) } else { String::new() },
         actions.name(),
         cfg.variables()
     );

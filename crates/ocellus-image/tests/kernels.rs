@@ -283,12 +283,16 @@ proptest! {
 
 #[test]
 fn preserving_filter_on_lanes_equals_one_map_at_a_time() {
+    // A symmetric kernel (folded: paired taps) and a lopsided one (every tap single).
     let g: Vec<f32> = (-14i32..=14).map(|i| (-(i * i) as f32 / 200.0).exp()).collect();
-    for (w, h) in [(40, 30), (37, 25), (3, 2)] {
+    let lopsided: Vec<f32> = (-3i32..=3).map(|i| (-((i - 1) * (i - 1)) as f32 / 4.0).exp()).collect();
+    for ((w, h), g) in
+        [(40, 30), (37, 25), (3, 2), (40, 30), (11, 9)].into_iter().zip([&g, &g, &g, &lopsided, &lopsided])
+    {
         let maps: Vec<Plane<f32>> = (0..8).map(|m| noise(w, h, 100 + m)).collect();
         let lanes = Plane::from_fn(w, h, |x, y| std::array::from_fn(|l| maps[l].get(x, y)));
         for b in Backend::available() {
-            let mut f = PreservingFilter::new(&g, w, h).unwrap();
+            let mut f = PreservingFilter::new(g, w, h).unwrap();
             let mut out = Plane::default();
             f.apply_lanes(b, &lanes, &mut out).unwrap();
             for (l, m) in maps.iter().enumerate() {

@@ -7,10 +7,13 @@
 //!   R rotating from +x towards +y.
 //!
 //! The 2D motor space holds (dx, dy) in pixels for translations and (theta in radians, s) for
-//! rotation + dilation. The motor code q of an action is either one-hot over a list of
-//! discrete action values (experiment 1: one fixed motor field per value) or the bilinear
-//! weights of its point over a grid of motor cells spanning the space (experiment 2:
-//! 15 x 15 cells), a population code that sums to 1.
+//! rotation + dilation. The motor code q of an action is one of:
+//! - one-hot over the cells of a grid tiling the space (experiment 1 by default: 60 fixed
+//!   motor fields as 10 x 6 cells, each triplet's action anywhere inside its cell);
+//! - one-hot over a list of discrete action values (experiment 1 as first built: one fixed
+//!   motor field per exact value on the two axes);
+//! - the bilinear weights of its point over a grid of motor cells spanning the space
+//!   (experiment 2: 15 x 15 cells), a population code that sums to 1.
 
 use crate::{Result, RetinaError};
 
@@ -191,6 +194,29 @@ impl ActionRanges {
         }
     }
 
+    /// How `count` motor fields tile the 2D motor space of `kinds`: `(nx, ny)` cells along the
+    /// first axis (dx or rotation) and the second (dy or log-scale), `nx` the smallest divisor
+    /// of `count` not below its square root (60: 10 x 6; 20: 5 x 4).
+    pub fn cells(&self, kinds: ActionKinds, count: usize) -> Result<(usize, usize)> {
+        self.extent(kinds)?;
+        let nx = (1..=count).find(|&d| count % d == 0 && d * d >= count).ok_or_else(|| {
+            RetinaError::Invalid(format!("{count} motor fields cannot tile the motor space: at least one is needed"))
+        })?;
+        Ok((nx, count / nx))
+    }
+
+    /// An action of a 2D kind inside cell `cell` (row-major over `cells`, see
+    /// [`cells`](Self::cells)) of the motor space, at the cell's relative point `u` in
+    /// [0, 1)^2.
+    pub fn in_cell(&self, kinds: ActionKinds, cells: (usize, usize), cell: usize, u: [f64; 2]) -> Result<Action> {
+        let (nx, ny) = cells;
+        if nx == 0 || ny == 0 || cell >= nx * ny {
+            return Err(RetinaError::Invalid(format!("cell {cell} of a {nx} x {ny} motor grid")));
+        }
+        let (ix, iy) = (cell % nx, cell / nx);
+        self.uniform(kinds, [(ix as f64 + u[0]) / nx as f64, (iy as f64 + u[1]) / ny as f64])
+    }
+
     /// A uniform random action of a 2D kind, from two uniforms in [0, 1).
     pub fn uniform(&self, kinds: ActionKinds, u: [f64; 2]) -> Result<Action> {
         let e = self.extent(kinds)?;
@@ -208,6 +234,17 @@ impl ActionRanges {
 pub enum MotorCode {
     /// One cell per listed action value (compared exactly).
     OneHot(Vec<Action>),
+    /// An `nx x ny` grid of cells tiling `extent` (row-major, the first axis fastest): q is
+    /// one-hot over the cell that holds the action's point (a point on an inner edge belongs
+    /// to the cell above it, up to rounding; the outer edges to the cells they close).
+    Cells {
+        /// Cells along the first motor axis.
+        nx: usize,
+        /// Cells along the second.
+        ny: usize,
+        /// [lo, hi] of each motor axis.
+        extent: [[f64; 2]; 2],
+    },
     /// A `cells x cells` grid spanning `extent`; an action's point spreads bilinearly over
     /// the four nearest cell centres (cell centres at the grid's nodes, edges included).
     Grid {
@@ -223,6 +260,7 @@ impl MotorCode {
     pub fn len(&self) -> usize {
         match self {
             MotorCode::OneHot(v) => v.len(),
+            MotorCode::Cells { nx, ny, .. } => nx * ny,
             MotorCode::Grid { cells, .. } => cells * cells,
         }
     }
@@ -242,6 +280,19 @@ impl MotorCode {
                     .position(|v| v == action)
                     .ok_or_else(|| RetinaError::Invalid(format!("{action:?} is not one of the motor values")))?;
                 q[i] = 1.0;
+            }
+            MotorCode::Cells { nx, ny, extent } => {
+                let p = action.motor_point();
+                let mut idx = [0usize; 2];
+                for (a, n) in [*nx, *ny].into_iter().enumerate() {
+                    let [lo, hi] = extent[a];
+                    let t = (p[a] - lo) / (hi - lo) * n as f64;
+                    if n == 0 || !(t.is_finite() && (-1e-9..=n as f64 + 1e-9).contains(&t)) {
+                        return Err(RetinaError::Invalid(format!("{action:?} lies outside the motor space")));
+                    }
+                    idx[a] = (t.max(0.0).floor() as usize).min(n - 1);
+                }
+                q[idx[1] * nx + idx[0]] = 1.0;
             }
             MotorCode::Grid { cells, extent } => {
                 let n = *cells;
@@ -297,6 +348,39 @@ mod tests {
             }
         }
         assert!(r.discrete(ActionKinds::Translation, 58).is_err());
+    }
+
+    #[test]
+    fn cells_tile_the_motor_space_and_code_their_actions() {
+        let r = ActionRanges::for_radius(30.23);
+        assert_eq!(r.cells(ActionKinds::RotationDilation, 60).unwrap(), (10, 6));
+        assert_eq!(r.cells(ActionKinds::Translation, 20).unwrap(), (5, 4));
+        assert_eq!(r.cells(ActionKinds::Translation, 7).unwrap(), (7, 1));
+        assert!(r.cells(ActionKinds::All, 60).is_err());
+        assert!(r.cells(ActionKinds::Translation, 0).is_err());
+        let kinds = ActionKinds::RotationDilation;
+        let code = MotorCode::Cells { nx: 10, ny: 6, extent: r.extent(kinds).unwrap() };
+        let mut q = vec![0.0; code.len()];
+        assert_eq!(q.len(), 60);
+        for cell in 0..60 {
+            for u in [[0.001, 0.001], [0.5, 0.25], [0.999, 0.999]] {
+                let a = r.in_cell(kinds, (10, 6), cell, u).unwrap();
+                code.encode(&a, &mut q).unwrap();
+                assert_eq!(q[cell], 1.0, "cell {cell} at {u:?}");
+                assert_eq!(q.iter().sum::<f64>(), 1.0);
+            }
+        }
+        // Cell 13 of 10 x 6 is column 3, row 1: rotation in [-12, -6] degrees, log-scale in
+        // [-0.2, -0.1].
+        let Action::RotateDilate { theta, s } = r.in_cell(kinds, (10, 6), 13, [0.5, 0.5]).unwrap() else {
+            panic!("a rotation-dilation cell gives a rotation-dilation")
+        };
+        assert!((theta.to_degrees() + 9.0).abs() < 1e-9 && (s + 0.15).abs() < 1e-12);
+        // The outer edge belongs to the last cell; beyond it is refused.
+        code.encode(&Action::RotateDilate { theta: r.rotation_rad, s: r.log_scale }, &mut q).unwrap();
+        assert_eq!(q[59], 1.0);
+        assert!(code.encode(&Action::RotateDilate { theta: 1.0, s: 0.0 }, &mut q).is_err());
+        assert!(r.in_cell(kinds, (10, 6), 60, [0.0, 0.0]).is_err());
     }
 
     #[test]

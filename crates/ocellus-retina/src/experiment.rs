@@ -1,8 +1,13 @@
 //! The seed's two experiments (SPEC 8.3) and reduced versions of them.
 //!
-//! 1. **Sensor design**: 60 fixed motor fields, one per action value (M = identity, q
-//!    one-hot), 68 triplets per value (4080), 2877 pixels, 48 receptive fields: S 138,096 +
-//!    P 138,240 = 276,336 variables (the seed: "about 275,000").
+//! 1. **Sensor design**: 60 fixed motor fields in a 2D motor space (M = identity, q
+//!    one-hot), 68 triplets per field (4080), 2877 pixels, 48 receptive fields: S 138,096 +
+//!    P 138,240 = 276,336 variables (the seed: "about 275,000"). The fields tile the motor
+//!    space as 10 x 6 cells and each triplet's action lies anywhere in its field's cell
+//!    ([`MotorSpace::Cells`], the default), or each field is one exact action value
+//!    ([`MotorSpace::Values`]). With cells, one predictor serves a range of actions, and
+//!    the spread of what it must predict grows with eccentricity under rotation and
+//!    dilation but not under translation: the pressure that makes peripheral fields large.
 //! 2. **Co-development**: a 15 x 15 grid of motor cells over the 2D motor space (225), 481
 //!    pixels, 16 receptive fields and 16 motor fields, all learned; 22,500 triplets with
 //!    uniform random actions: S 7,696 + M 3,600 + P 4,096 = 15,392 (the seed: "about
@@ -51,6 +56,37 @@ pub struct ExperimentConfig {
     /// Experiment 2: weight of the motor fields' smoothness over the motor grid (see
     /// [`crate::model::Objective::smoothness`]); 0 for none.
     pub motor_smoothness: f64,
+    /// Experiment 1: what a fixed motor field stands for (checkpoints written before this
+    /// choice existed were of [`MotorSpace::Values`]).
+    #[serde(default = "MotorSpace::values")]
+    pub motor_space: MotorSpace,
+}
+
+/// Experiment 1: what each of its fixed motor fields stands for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MotorSpace {
+    /// A cell of a grid tiling the 2D motor space (see [`ActionRanges::cells`]); each
+    /// triplet's action is drawn uniformly inside its field's cell. Translation or
+    /// rotation + dilation only.
+    Cells,
+    /// One exact action value, spread evenly over the axes (see
+    /// [`ActionRanges::discrete`]); all four actions allowed.
+    Values,
+}
+
+impl MotorSpace {
+    fn values() -> Self {
+        Self::Values
+    }
+
+    /// Name as on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Cells => "cells",
+            Self::Values => "values",
+        }
+    }
 }
 
 impl ExperimentConfig {
@@ -70,6 +106,7 @@ impl ExperimentConfig {
             blur_px: DEFAULT_BLUR_PX,
             action_scale: 1.0,
             motor_smoothness: 0.0,
+            motor_space: if actions == ActionKinds::All { MotorSpace::Values } else { MotorSpace::Cells },
         }
     }
 
@@ -101,6 +138,12 @@ impl ExperimentConfig {
         if self.experiment == 2 && self.actions == ActionKinds::All {
             return Err(RetinaError::Invalid(
                 "experiment 2 has a 2D motor space: use translation or rotation-dilation actions".into(),
+            ));
+        }
+        if self.experiment == 1 && self.motor_space == MotorSpace::Cells && self.actions == ActionKinds::All {
+            return Err(RetinaError::Invalid(
+                "motor fields as cells tile a 2D motor space: use translation or rotation-dilation actions, or motor fields as values"
+                    .into(),
             ));
         }
         if self.experiment == 2 && self.grid_cells < 2 {
@@ -185,7 +228,22 @@ pub fn setup<T: Real>(config: &ExperimentConfig, sources: &[Plane<f32>]) -> Resu
     let k = config.action_scale;
     let ranges =
         ActionRanges { shift_px: k * d.shift_px, rotation_rad: k * d.rotation_rad, log_scale: k * d.log_scale };
-    let (code, train_actions, held_actions) = if config.experiment == 1 {
+    let (code, train_actions, held_actions) = if config.experiment == 1 && config.motor_space == MotorSpace::Cells {
+        let cells = ranges.cells(config.actions, config.motor_fields)?;
+        let extent = ranges.extent(config.actions)?;
+        let mut rng = SplitMix64::new(config.seed ^ 0xCE11_5EED);
+        let mut draw = |per: usize| -> Result<Vec<Action>> {
+            let mut v = Vec::with_capacity(per * config.motor_fields);
+            for cell in 0..config.motor_fields {
+                for _ in 0..per {
+                    v.push(ranges.in_cell(config.actions, cells, cell, [rng.unit(), rng.unit()])?);
+                }
+            }
+            Ok(v)
+        };
+        let (a, b) = (draw(config.triplets)?, draw(config.heldout)?);
+        (MotorCode::Cells { nx: cells.0, ny: cells.1, extent }, a, b)
+    } else if config.experiment == 1 {
         let values = ranges.discrete(config.actions, config.motor_fields)?;
         let rep = |k: usize| values.iter().flat_map(|a| std::iter::repeat(*a).take(k)).collect::<Vec<Action>>();
         (MotorCode::OneHot(values.clone()), rep(config.triplets), rep(config.heldout))
@@ -321,6 +379,11 @@ mod tests {
         assert_eq!(two.shape().sizes(), [7_696, 3_600, 4_096]);
         assert_eq!(two.variables(), 15_392);
         assert!(ExperimentConfig { actions: ActionKinds::All, ..two }.validate().is_err());
+        // All four actions have no 2D motor space to tile.
+        assert_eq!(ExperimentConfig::sensor_design(ActionKinds::All).motor_space, MotorSpace::Values);
+        assert!(ExperimentConfig { actions: ActionKinds::All, motor_space: MotorSpace::Cells, ..one }
+            .validate()
+            .is_err());
         assert!(ExperimentConfig { fields: 0, ..one }.validate().is_err());
         assert!(ExperimentConfig { simplicity: f64::NAN, ..one }.validate().is_err());
     }
