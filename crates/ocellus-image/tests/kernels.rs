@@ -283,7 +283,7 @@ proptest! {
 
 #[test]
 fn preserving_filter_on_lanes_equals_one_map_at_a_time() {
-    // A symmetric kernel (folded: paired taps) and a lopsided one (every tap single).
+    // A symmetric kernel and a lopsided one.
     let g: Vec<f32> = (-14i32..=14).map(|i| (-(i * i) as f32 / 200.0).exp()).collect();
     let lopsided: Vec<f32> = (-3i32..=3).map(|i| (-((i - 1) * (i - 1)) as f32 / 4.0).exp()).collect();
     for ((w, h), g) in
