@@ -299,11 +299,14 @@ fn learn(a: LearnArgs) -> Result<()> {
         baseline.as_ref().map(|b| format!(", random fixed S {:.6}", b.0)).unwrap_or_default()
     );
     outln!(
-        "layout: {} live fields ({} dead), fovea index {:.3} (start {:.3}), slope {:.2} px^2/px, areas centre {:.1} / periphery {:.1} px^2, density ratio {}",
+        "layout: {} live fields ({} dead), fovea index {:.3} (start {:.3}), over the {} interior fields {:.3} (start {:.3}), slope {:.2} px^2/px, areas centre {:.1} / periphery {:.1} px^2, density ratio {}",
         layout.fields.len(),
         layout.dead,
         layout.fovea_index,
         layout0.fovea_index,
+        layout.interior_fields,
+        layout.fovea_index_interior,
+        layout0.fovea_index_interior,
         layout.slope_px2_per_px,
         layout.mean_area_centre_px,
         layout.mean_area_periphery_px,
@@ -344,6 +347,8 @@ fn learn(a: LearnArgs) -> Result<()> {
         "improvement_over_random_s": baseline.as_ref().map(|b| b.0 / mse_learned),
         "fovea_index": layout.fovea_index,
         "fovea_index_start": layout0.fovea_index,
+        "fovea_index_interior": layout.fovea_index_interior,
+        "fovea_index_interior_start": layout0.fovea_index_interior,
         "layout": layout,
     });
     let f = a.out.join("retina.json");

@@ -31,6 +31,13 @@ pub struct Layout {
     /// fields; positive when fields grow toward the periphery. 0 with fewer than 3 fields
     /// or no spread.
     pub fovea_index: f64,
+    /// The fovea index over the interior fields only: those whose half-maximum disc (of the
+    /// field's area) lies inside the sensor, 0.5 px from its rim. The rim cuts the fields
+    /// there and makes them look smaller or larger than they are; this index is free of that.
+    /// 0 with fewer than 3 interior fields.
+    pub fovea_index_interior: f64,
+    /// Interior fields counted in [`fovea_index_interior`](Self::fovea_index_interior).
+    pub interior_fields: usize,
     /// Least-squares slope of area against eccentricity, px^2 per px.
     pub slope_px2_per_px: f64,
     /// Field centres per unit area inside half the disc radius over those outside it
@@ -73,6 +80,10 @@ pub fn measure<T: Real>(disc: &Disc, s: &[T], fields: usize) -> Result<Layout> {
     }
     let dead = fields - out.len();
     let (fovea_index, slope) = correlation(&out);
+    let rim = disc.radius() - 0.5;
+    let interior: Vec<Field> =
+        out.iter().filter(|f| f.eccentricity + (f.area_px / std::f64::consts::PI).sqrt() < rim).copied().collect();
+    let (fovea_index_interior, _) = correlation(&interior);
     let half = 0.5 * disc.radius();
     let (inner, outer): (Vec<&Field>, Vec<&Field>) = out.iter().partition(|f| f.eccentricity < half);
     let mean =
@@ -82,6 +93,8 @@ pub fn measure<T: Real>(disc: &Disc, s: &[T], fields: usize) -> Result<Layout> {
     Ok(Layout {
         dead,
         fovea_index,
+        fovea_index_interior,
+        interior_fields: interior.len(),
         slope_px2_per_px: slope,
         density_ratio,
         mean_area_centre_px: mean(&inner),
@@ -139,6 +152,14 @@ mod tests {
         let l = measure(&disc, &blobs(&disc, &spec), 24).unwrap();
         assert_eq!(l.fields.len(), 24);
         assert!(l.fovea_index > 0.9, "{}", l.fovea_index);
+        // Every half-maximum disc lies inside (r + 1.18 w < 29.7 up to r = 24).
+        assert_eq!(l.interior_fields, 24);
+        assert!((l.fovea_index_interior - l.fovea_index).abs() < 1e-12);
+        // A field at the rim is cut and counts only in the plain index.
+        let mut rimmed = spec.clone();
+        rimmed.push(([29.0, 0.0], 3.0));
+        let l = measure(&disc, &blobs(&disc, &rimmed), 25).unwrap();
+        assert_eq!((l.fields.len(), l.interior_fields), (25, 24));
         // The area above half maximum of a Gaussian of width w is about 2 ln 2 pi w^2 px^2:
         // the slope follows from d/dr of that at the mean width.
         assert!(l.slope_px2_per_px > 0.0 && l.mean_area_periphery_px > l.mean_area_centre_px);
@@ -147,6 +168,7 @@ mod tests {
         let same: Vec<([f64; 2], f64)> = spec.iter().map(|&(c, _)| (c, 2.0)).collect();
         let l = measure(&disc, &blobs(&disc, &same), 24).unwrap();
         assert!(l.fovea_index.abs() < 0.3, "{}", l.fovea_index);
+        assert!(l.fovea_index_interior.abs() < 0.3, "{}", l.fovea_index_interior);
         assert!(measure(&disc, &[0.0f64; 10], 2).is_err());
     }
 
