@@ -127,7 +127,7 @@ struct LearnArgs {
     /// default, `--baseline false` skips it.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
     baseline: bool,
-    /// Experiment 1 reduced (481 pixels, 16 fields, 20 action values x 24 triplets), for a
+    /// Experiment 1 reduced (481 pixels, 16 fields, 20 motor fields x 24 triplets), for a
     /// quick look.
     #[arg(long)]
     small: bool,

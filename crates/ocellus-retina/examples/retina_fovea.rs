@@ -1,5 +1,6 @@
 //! Does a fovea emerge? Experiment 1 of the self-organizing retina at a reduced size (481
-//! pixels, 16 receptive fields, 20 action values x 24 triplets) on the built-in photographs
+//! pixels, 16 receptive fields, 20 motor fields as 5 x 4 cells of the motor space x 24
+//! triplets) on the built-in photographs
 //! and textures, once with translations and once with rotations + dilations, from the same
 //! random start: the fovea index (correlation of field size with eccentricity) and the
 //! held-out prediction error against the identity predictor.

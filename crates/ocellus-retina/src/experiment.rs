@@ -124,7 +124,7 @@ impl ExperimentConfig {
         }
     }
 
-    /// Experiment 1 reduced for tests: 481 pixels, 16 fields, 20 action values x 24
+    /// Experiment 1 reduced for tests: 481 pixels, 16 fields, 20 motor fields x 24
     /// triplets.
     pub fn sensor_design_small(actions: ActionKinds) -> Self {
         Self { pixels: 481, fields: 16, motor_fields: 20, triplets: 24, heldout: 8, ..Self::sensor_design(actions) }
