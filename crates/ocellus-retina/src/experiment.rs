@@ -387,4 +387,15 @@ mod tests {
         assert!(ExperimentConfig { fields: 0, ..one }.validate().is_err());
         assert!(ExperimentConfig { simplicity: f64::NAN, ..one }.validate().is_err());
     }
+
+    #[test]
+    fn a_config_saved_before_motor_spaces_existed_reads_as_values() {
+        let cells = ExperimentConfig::sensor_design(ActionKinds::RotationDilation);
+        assert_eq!(cells.motor_space, MotorSpace::Cells);
+        let mut json = serde_json::to_value(cells).unwrap();
+        assert_eq!(json["motor_space"], "cells");
+        json.as_object_mut().unwrap().remove("motor_space");
+        let old: ExperimentConfig = serde_json::from_value(json).unwrap();
+        assert_eq!(old, ExperimentConfig { motor_space: MotorSpace::Values, ..cells });
+    }
 }
