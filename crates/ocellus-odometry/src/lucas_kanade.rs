@@ -148,7 +148,8 @@ fn lk_sums_generic<M: Madd>(
     let inside = fx >= 0.0 && fy >= 0.0 && fx as usize + n < cur.width() && fy as usize + n < cur.height();
     if inside {
         let (ix, iy) = (fx as usize, fy as usize);
-        // Along x, then y (the order of `at`), without scratch rows; the gain applied once here.
+        // Along x, then y (the order of `sample_bilinear` below), without scratch rows; the gain
+        // applied once here.
         for (j, out) in patch.chunks_exact_mut(n).enumerate() {
             let (r0, r1) = (&cur.row(iy + j)[ix..ix + n + 1], &cur.row(iy + j + 1)[ix..ix + n + 1]);
             // Zipped slices, so the loop has no bounds tests and vectorizes.
