@@ -178,6 +178,16 @@ impl BallModel {
         self.weigh_circles(filter, obs, &circles)
     }
 
+    /// The weight update of a frame taken to carry no evidence, after `filter.propose`: the
+    /// particles keep their weights (times the proposal's importance ratio) and coast on the
+    /// motion model; states out of view (behind the camera) stay impossible.
+    pub fn coast(&self, filter: &mut ParticleFilter<BallState>) -> Result<StepReport> {
+        let circles: Vec<Option<Circle>> = filter.particles().par_iter().map(|s| self.circle(s)).collect();
+        Ok(filter.weigh_proposed_with(|_, out| {
+            out.iter_mut().zip(&circles).for_each(|(l, c)| *l = if c.is_some() { 0.0 } else { f64::NEG_INFINITY });
+        })?)
+    }
+
     /// [`Self::weigh`] with the particles' image circles already projected (`circles[i]` of
     /// particle `i`; `None` out of view).
     fn weigh_circles(

@@ -24,6 +24,7 @@ use crate::colour::{Circle, ColourModel};
 use crate::detection::{detect_balls, BallDetection, DetectorConfig};
 use crate::motion::MotionModel;
 use crate::{Result, TrackingError};
+use nalgebra::Vector3;
 use ocellus_estimation::particle_filter::{FilterConfig, ParticleFilter};
 use ocellus_geometry::camera::PinholeCamera;
 use ocellus_geometry::distortion::Distortion;
@@ -57,12 +58,32 @@ pub struct TrackerConfig {
     /// Share of the proposal drawn from the detections in a frame after a lost estimate,
     /// in [0, 1] (at least `boost`; the plain filter, `boost = 0`, stays plain).
     pub boost_when_lost: f64,
+    /// While lost, a detection re-acquires the ball only when its distance from the camera
+    /// lies within this many standard deviations (the detection's depth spread and the
+    /// coasted cloud's, combined) of the cloud's mean distance, in (0, inf]; `inf` turns
+    /// the gate off. The cloud spreads while it coasts, so the gate widens with the time
+    /// lost (about 0.5 m after 0.2 s and 6 m after 1 s at the default motion noise).
+    #[serde(default = "default_reacquire_gate_sigmas")]
+    pub reacquire_gate_sigmas: f64,
+    /// While lost, the boosted filter re-acquires only from detections: a frame without one
+    /// carries no evidence and the cloud coasts.
+    #[serde(default = "default_coast_while_lost")]
+    pub coast_while_lost: bool,
+}
+
+fn default_reacquire_gate_sigmas() -> f64 {
+    3.0
+}
+
+fn default_coast_while_lost() -> bool {
+    true
 }
 
 impl TrackerConfig {
     /// Defaults for frames at `fps`: 4000 particles, boost 0.2, resampling below ESS N/2,
     /// lambda 20, lost below score 0.2, frames where no particle scores 0.2 carry no
-    /// evidence, the whole proposal from the detections after a loss.
+    /// evidence, the whole proposal from the detections after a loss, gated at 3 standard
+    /// deviations of distance, and no re-acquisition by the coasting cloud alone.
     pub fn at_fps(fps: f64) -> Self {
         Self {
             particles: 4000,
@@ -74,6 +95,8 @@ impl TrackerConfig {
             lost_score: 0.2,
             evidence_score: 0.2,
             boost_when_lost: 1.0,
+            reacquire_gate_sigmas: default_reacquire_gate_sigmas(),
+            coast_while_lost: default_coast_while_lost(),
         }
     }
 
@@ -93,6 +116,12 @@ impl TrackerConfig {
         }
         if !(0.0..=1.0).contains(&self.boost_when_lost) {
             return Err(TrackingError::Invalid(format!("boost_when_lost {} is outside [0, 1]", self.boost_when_lost)));
+        }
+        if !(self.reacquire_gate_sigmas > 0.0) {
+            return Err(TrackingError::Invalid(format!(
+                "reacquire_gate_sigmas {} must be above 0 (inf: no gate)",
+                self.reacquire_gate_sigmas
+            )));
         }
         if !(0.0..=1.0).contains(&self.filter.resample_below) {
             return Err(TrackingError::Invalid(format!(
@@ -259,6 +288,23 @@ impl BallTracker {
             // coasted pays the motion prior's small density in its importance weight: the
             // cloud would stay with wrong circles. With every particle from the detections
             // they compete on the likelihood and the prior alike.
+            //
+            // Two guards keep a lost cloud from being carried off. A detection at a distance
+            // the hidden ball cannot have reached (a small blob of the background, far away)
+            // is not used. And with no detection, the cloud does not re-acquire the ball on
+            // its own: meeting a ball that comes out from behind an occluder, its coasted
+            // particles collapse onto the few small circles that fit the visible part, too
+            // far away, and the filter then takes many frames to bring the depth back; the
+            // blob, once the detector finds it, starts a fresh cloud.
+            if self.lost {
+                let gate = self.cfg.reacquire_gate_sigmas;
+                let (mean, var) = distance_moments(f, self.model.camera.centre());
+                self.obs.detections.retain(|d| within_gate(d, mean, var, gate));
+                if self.obs.detections.is_empty() && self.cfg.coast_while_lost {
+                    f.propose(&self.model, &self.obs);
+                    return Ok(self.model.coast(f)?.ess);
+                }
+            }
             let alpha = self.model.boost;
             if self.lost && !self.obs.detections.is_empty() {
                 self.model.boost = self.cfg.boost_when_lost.max(alpha);
@@ -296,9 +342,48 @@ impl BallTracker {
     }
 }
 
+/// The weighted mean and variance of the particles' distances from `centre`, metres and m^2.
+fn distance_moments(f: &ParticleFilter<BallState>, centre: Vector3<f64>) -> (f64, f64) {
+    let w = f.weights();
+    let d: Vec<f64> = f.particles().iter().map(|p| (Vector3::from(p.position) - centre).norm()).collect();
+    let mean: f64 = d.iter().zip(&w).map(|(d, w)| d * w).sum();
+    let var = d.iter().zip(&w).map(|(d, w)| w * (d - mean).powi(2)).sum();
+    (mean, var)
+}
+
+/// Whether a detection's distance lies within `gate` standard deviations of a cloud's
+/// distance (`mean`, `var`), the detection's own depth spread added.
+fn within_gate(d: &BallDetection, mean: f64, var: f64, gate: f64) -> bool {
+    (d.distance_m - mean).abs() <= gate * (var + d.sigma_depth_m * d.sigma_depth_m).sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_reacquisition_gate_is_on_distance() {
+        // Particles 2.0 and 2.2 m from the camera (one along its axis, one off it), equally
+        // weighed: mean 2.1 m, variance 0.01 m^2.
+        let at = |p: [f64; 3]| BallState { position: p, velocity: [0.0; 3] };
+        let f = ParticleFilter::new(FilterConfig::default(), vec![at([0.0, 0.0, 2.0]), at([1.32, 0.0, 1.76])]).unwrap();
+        let (mean, var) = distance_moments(&f, Vector3::zeros());
+        assert!((mean - 2.1).abs() < 1e-12 && (var - 0.01).abs() < 1e-12, "{mean} {var}");
+        let det = |distance_m: f64| BallDetection {
+            circle: Circle { x: 0.0, y: 0.0, r: 1.0 },
+            position: [0.0, 0.0, distance_m],
+            direction: [0.0, 0.0, 1.0],
+            distance_m,
+            sigma_lateral_m: 0.01,
+            sigma_depth_m: 0.1,
+        };
+        // 3 sigma of sqrt(0.01 + 0.01) m: 0.424 m either way.
+        assert!(within_gate(&det(2.5), mean, var, 3.0));
+        assert!(within_gate(&det(1.7), mean, var, 3.0));
+        assert!(!within_gate(&det(2.55), mean, var, 3.0));
+        assert!(!within_gate(&det(8.0), mean, var, 3.0));
+        assert!(within_gate(&det(8.0), mean, var, f64::INFINITY));
+    }
 
     #[test]
     fn bad_settings_are_refused() {
@@ -311,6 +396,8 @@ mod tests {
             TrackerConfig { evidence_score: f64::INFINITY, ..ok },
             TrackerConfig { boost_when_lost: -0.1, ..ok },
             TrackerConfig { boost_when_lost: f64::NAN, ..ok },
+            TrackerConfig { reacquire_gate_sigmas: 0.0, ..ok },
+            TrackerConfig { reacquire_gate_sigmas: f64::NAN, ..ok },
         ] {
             assert!(bad.validate().is_err(), "{bad:?}");
         }
