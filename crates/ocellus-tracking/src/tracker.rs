@@ -117,7 +117,7 @@ impl TrackerConfig {
         if !(0.0..=1.0).contains(&self.boost_when_lost) {
             return Err(TrackingError::Invalid(format!("boost_when_lost {} is outside [0, 1]", self.boost_when_lost)));
         }
-        if !(self.reacquire_gate_sigmas > 0.0) {
+        if self.reacquire_gate_sigmas.is_nan() || self.reacquire_gate_sigmas <= 0.0 {
             return Err(TrackingError::Invalid(format!(
                 "reacquire_gate_sigmas {} must be above 0 (inf: no gate)",
                 self.reacquire_gate_sigmas
