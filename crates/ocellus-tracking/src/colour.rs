@@ -20,8 +20,8 @@
 //! target, or about a target half hidden, which a smaller circle in its visible part fits
 //! better. The rim term ([`ColourModel::rim`]) reads the edge itself: on [`RIM_SAMPLES`] rays
 //! it compares the pixel [`RIM_INSIDE_PX`] inside the circle with the one [`RIM_OUTSIDE_PX`]
-//! outside. A ray
-//! with the target's colour inside and not outside votes +1 (the edge is there); one with the
+//! outside. A ray with the target's colour inside and not outside votes +1 (the edge is
+//! there); one with the
 //! target's colour outside votes -1 (the circle is too small, or off); one with neither votes
 //! 0 (hidden there, or the circle too large, which the disc's histogram punishes). A half-hidden
 //! ball's true circle keeps the votes of its visible arc; a smaller circle inside the visible
@@ -36,8 +36,9 @@
 //! disc, took the smallest: on the generated sequences (Lambert-shaded, 2x2-supersampled
 //! balls of radius 10-17 px) the likelihood peaked 1.3-3.3 % too far (mean 2.3 % over 12
 //! fully visible frames). Reading the inside 0.75 px and the outside 0.25 px from the edge
-//! moved the peak to -1.3..+1.3 % (mean 0.25 %; a throwaway scan of the depth in steps of 0.25 %), and the boosted tracker's 3D RMSE without
-//! occluders from a median of 1.63 % to 0.57 % of the depth (9 runs).
+//! moved the peak to -1.3..+1.3 % (mean 0.25 %; a throwaway scan of the depth in steps of
+//! 0.25 %), and the boosted tracker's 3D RMSE without occluders from a median of 1.63 % to
+//! 0.57 % of the depth (9 runs).
 //!
 //! `score = BC(inner, model) - BC(inner, outer)`, BC the Bhattacharyya coefficient
 //! `sum_b sqrt(p_b q_b)` in [0, 1]: high when the disc looks like the model and unlike its

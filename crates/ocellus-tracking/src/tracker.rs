@@ -62,7 +62,8 @@ pub struct TrackerConfig {
     /// lies within this many standard deviations (the detection's depth spread and the
     /// coasted cloud's, combined) of the cloud's mean distance, in (0, inf]; `inf` turns
     /// the gate off. The cloud spreads while it coasts, so the gate widens with the time
-    /// lost (about 0.5 m after 0.2 s and 6 m after 1 s at the default motion noise).
+    /// lost t: the standard deviation of its distance grows about as sigma_a t^2 / sqrt(3),
+    /// 0.23 m after 0.2 s and 5.8 m after 1 s at the default sigma_a of 10 m/s^2.
     #[serde(default = "default_reacquire_gate_sigmas")]
     pub reacquire_gate_sigmas: f64,
     /// While lost, the boosted filter re-acquires only from detections: a frame without one
