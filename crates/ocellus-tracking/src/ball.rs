@@ -183,9 +183,7 @@ impl BallModel {
     /// motion model; states out of view (behind the camera) stay impossible.
     pub fn coast(&self, filter: &mut ParticleFilter<BallState>) -> Result<StepReport> {
         let circles: Vec<Option<Circle>> = filter.particles().par_iter().map(|s| self.circle(s)).collect();
-        Ok(filter.weigh_proposed_with(|_, out| {
-            out.iter_mut().zip(&circles).for_each(|(l, c)| *l = if c.is_some() { 0.0 } else { f64::NEG_INFINITY });
-        })?)
+        Ok(filter.weigh_proposed_with(|_, out| carry_no_evidence(&circles, out))?)
     }
 
     /// [`Self::weigh`] with the particles' image circles already projected (`circles[i]` of
@@ -204,11 +202,16 @@ impl BallModel {
                 *l = c.map_or(f64::NEG_INFINITY, |c| self.colour.log_likelihood(binned, c));
             });
             if out.iter().all(|&l| l < least) {
-                // Impossible states (behind the camera) stay impossible.
-                out.iter_mut().filter(|l| l.is_finite()).for_each(|l| *l = 0.0);
+                carry_no_evidence(circles, out);
             }
         })?)
     }
+}
+
+/// The log likelihoods of a frame without evidence: 0 for every state in view, so the
+/// weights are kept; states out of view (behind the camera) stay impossible.
+fn carry_no_evidence(circles: &[Option<Circle>], out: &mut [f64]) {
+    out.iter_mut().zip(circles).for_each(|(l, c)| *l = if c.is_some() { 0.0 } else { f64::NEG_INFINITY });
 }
 
 /// The rectangle holding every sample of every circle in a `w` x `h` frame (`None`: out of

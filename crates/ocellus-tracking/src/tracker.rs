@@ -298,9 +298,11 @@ impl BallTracker {
             // far away, and the filter then takes many frames to bring the depth back; the
             // blob, once the detector finds it, starts a fresh cloud.
             if self.lost {
-                let gate = self.cfg.reacquire_gate_sigmas;
-                let (mean, var) = distance_moments(f, self.model.camera.centre());
-                self.obs.detections.retain(|d| within_gate(d, mean, var, gate));
+                if !self.obs.detections.is_empty() {
+                    let gate = self.cfg.reacquire_gate_sigmas;
+                    let (mean, var) = distance_moments(f, self.model.camera.centre());
+                    self.obs.detections.retain(|d| within_gate(d, mean, var, gate));
+                }
                 if self.obs.detections.is_empty() && self.cfg.coast_while_lost {
                     f.propose(&self.model, &self.obs);
                     return Ok(self.model.coast(f)?.ess);
