@@ -51,6 +51,12 @@ pub struct OdometryArgs {
     /// height stays at the calibrated value, the seed's assumption). Range: 0..=1.
     #[arg(long, default_value_t = 0.002, value_parser = ranges::within(0.0f64, 1.0))]
     height_pull: f64,
+    /// Robust mode: window, frames, of the running noise and power of the image's scale
+    /// change; each change is shrunk by their ratio (the Wiener gain) before the height
+    /// follows it, so a floor whose height is constant does not integrate noise (0: every
+    /// change followed whole). Range: 0 or 1..=1000000.
+    #[arg(long, default_value_t = 32.0, value_parser = ranges::within(0.0f64, 1e6))]
+    height_noise_frames: f64,
     /// Frame rate, Hz (timestamps of the trajectory). Range: above 0, at most 1000000.
     #[arg(long, default_value_t = 200.0, value_parser = ranges::above(0.0f64, 1e6))]
     rate_hz: f64,
@@ -127,6 +133,7 @@ pub fn run(a: OdometryArgs) -> Result<()> {
         Mode::Robust => OdometryConfig::robust(height, focal, mount),
     };
     cfg.robust.height_pull = a.height_pull;
+    cfg.robust.height_noise_frames = a.height_noise_frames;
     let mut vo = VisualOdometry::new(cfg)?;
     let readings: Option<Vec<EncoderReading>> = match &a.encoders {
         Some(p) => {

@@ -142,6 +142,8 @@ const CASES: &[Case] = &[
     c("odometry {D}/frames --camera {D}/cam.toml --height-m 0 --out {O}", Usage(&["--height-m", "range"])),
     c("odometry {D}/frames --camera {D}/cam.toml --height-pull 1.5 --out {O}", Usage(&["--height-pull", "range"])),
     c("odometry {D}/frames --camera {D}/cam.toml --height-pull NaN --out {O}", Usage(&["--height-pull", "range"])),
+    c("odometry {D}/frames --camera {D}/cam.toml --height-noise-frames -1 --out {O}", Usage(&["--height-noise-frames", "range"])),
+    c("odometry {D}/frames --camera {D}/cam.toml --height-noise-frames 0.5 --out {O}", Error(&["height noise window", "at least 1"])),
     c("odometry {D}/frames --camera {D}/cam.toml --mount-right-m 1e9 --out {O}", Usage(&["--mount-right-m", "range"])),
     c("odometry {D}/frames --camera {D}/cam.toml --encoder-rate-hz 0 --out {O}", Usage(&["--encoder-rate-hz"])),
     c("odometry {D}/frames --camera {D}/missing.toml --out {O}", Error(&["missing.toml"])),

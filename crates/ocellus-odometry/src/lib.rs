@@ -24,6 +24,7 @@
 //! ```
 
 pub mod fusion;
+pub mod height;
 pub mod kinematics;
 pub mod lucas_kanade;
 pub mod robust;

@@ -125,7 +125,7 @@ pub struct VisualOdometry {
     p: Matrix3<f64>,
     pose: Pose2,
     /// The followed camera height over the calibrated one (robust mode; 1 in seed mode).
-    height_ratio: f64,
+    height: crate::height::HeightFollower,
 }
 
 impl VisualOdometry {
@@ -148,7 +148,7 @@ impl VisualOdometry {
             x: Vector3::zeros(),
             p,
             pose: Pose2::default(),
-            height_ratio: 1.0,
+            height: Default::default(),
         })
     }
 
@@ -171,7 +171,7 @@ impl VisualOdometry {
                 camera_motion_sigma: [0.0; 3],
                 flows: Vec::new(),
                 failure: None,
-                height_m: self.cfg.height_m * self.height_ratio,
+                height_m: self.cfg.height_m * self.height.ratio(),
             });
         };
         match self.cfg.mode {
@@ -230,13 +230,13 @@ impl VisualOdometry {
             camera_motion_sigma: self.sigma(),
             flows,
             failure,
-            height_m: self.cfg.height_m * self.height_ratio,
+            height_m: self.cfg.height_m * self.height.ratio(),
         }
     }
 
     fn step_robust(&mut self, prev: &Plane<u8>, frame: &Plane<u8>) -> Result<OdometryStep> {
         // The translation is measured in frame n-1's pixels, at frame n-1's height.
-        let scale = self.cfg.height_m * self.height_ratio / self.cfg.focal_px;
+        let scale = self.cfg.height_m * self.height.ratio() / self.cfg.focal_px;
         let sigma = self.cfg.robust.smooth_sigma_px;
         let backend = self.cfg.robust.flow.backend;
         // Valid again only once this frame's smoothing is in place (an error below leaves it so).
@@ -256,8 +256,8 @@ impl VisualOdometry {
                 // Frame n is frame n-1 magnified by 1 + k: the camera came down by 1 / (1 + k).
                 // A change beyond 20 % in one frame is not a height change the floor allows.
                 if f.scale_change.is_finite() && f.scale_change.abs() < 0.2 {
-                    let pull = self.cfg.robust.height_pull;
-                    self.height_ratio = 1.0 + (self.height_ratio / (1.0 + f.scale_change) - 1.0) * (1.0 - pull);
+                    let r = &self.cfg.robust;
+                    self.height.update(f.scale_change, r.height_pull, r.height_noise_frames);
                 }
                 // State (Tx, Ty, wz) = M (right_px, forward_px, turn), M = diag(-s, s, -1).
                 let z = Vector3::new(-scale * f.right_px, scale * f.forward_px, -f.turn_rad);

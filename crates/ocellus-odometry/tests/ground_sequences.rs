@@ -93,6 +93,25 @@ fn the_robust_mode_follows_the_camera_height() {
 }
 
 #[test]
+fn a_constant_height_is_not_followed_into_noise() {
+    // The real-camera low-contrast floor (no lens, which this test would have to undistort):
+    // its camera height is constant, and its image-scale changes are the noisiest of the
+    // floors. Followed whole, their noise moves the height; shrunk by the measured
+    // signal-to-noise ratio (`height_noise_frames`), much less.
+    let cfg = GroundConfig { frames: 120, k1: 0.0, ..GroundConfig::easy(GroundTexture::LowContrast, 1).real_camera() };
+    let scene = GroundScene::new(cfg, textures()).unwrap();
+    let worst = |window: f64| {
+        let mut vo_cfg = OdometryConfig::robust(0.3, 600.0, Mount { right_m: 0.0, forward_m: 0.05 });
+        vo_cfg.robust.height_noise_frames = window;
+        let mut vo = VisualOdometry::new(vo_cfg).unwrap();
+        (0..scene.len()).map(|k| (vo.step(&scene.frame(k).unwrap()).unwrap().height_m - 0.3).abs()).fold(0.0, f64::max)
+    };
+    let (whole, shrunk) = (worst(0.0), worst(32.0));
+    println!("height off by up to {:.4} mm followed whole, {:.4} mm shrunk", whole * 1e3, shrunk * 1e3);
+    assert!(shrunk < 0.5 * whole, "whole {whole} m, shrunk {shrunk} m");
+}
+
+#[test]
 fn robust_mode_holds_on_low_contrast_fine_grained_and_repetitive_floors_seen_by_a_real_camera() {
     // Before Lucas-Kanade ran on smoothed frames with a noise-relative texture test, these
     // drifted 0.07-0.15 % (seed 1, 200 frames): bilinear interpolation pulled every flow
