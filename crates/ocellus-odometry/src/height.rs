@@ -57,8 +57,8 @@ impl HeightFollower {
     /// Takes one frame's scale change `k` (frame n is frame n-1 magnified by 1 + k) with
     /// the pull toward the calibrated height `pull` (per frame, in [0, 1]) and the window of
     /// the noise estimate `window_frames` (0: no shrinkage); returns the new ratio. The
-    /// running moments take k before the new ratio is computed, so a first large change is
-    /// not followed whole.
+    /// running moments take k first, so the gain k is shrunk by includes it; the first
+    /// change, with no difference to read the noise from, is followed whole.
     pub fn update(&mut self, k: f64, pull: f64, window_frames: f64) -> f64 {
         self.seen += 1;
         let a = if window_frames > 0.0 { (1.0 / self.seen as f64).max(1.0 / window_frames) } else { 1.0 };
