@@ -155,6 +155,12 @@ struct StudyArgs {
     /// Add the lighting change to every sequence.
     #[arg(long)]
     lighting_change: bool,
+    /// Random streams per sequence: each is tracked this many times, the filter seeded by
+    /// the world's seed (stream 0) and then by seeds far from every world's; the summary
+    /// gives the median and mean of each stream, so that a change is judged against the
+    /// spread the random stream alone makes. Range: 1..=20.
+    #[arg(long, default_value_t = 1, value_parser = ranges::within(1u64, 20))]
+    streams: u64,
     /// Print one JSON object.
     #[arg(long)]
     json: bool,
@@ -519,20 +525,20 @@ fn run_study(a: &StudyArgs) -> Result<()> {
         distractor: a.distractor,
         lighting_change: a.lighting_change,
     };
-    let runs =
-        study(&photo("rocket.jpg")?, &photo("gravel.png")?, &trajectories, &seeds, &[0.0, a.boost], base, scene)?;
+    let (background, occluder) = (photo("rocket.jpg")?, photo("gravel.png")?);
+    let runs = study(&background, &occluder, &trajectories, &seeds, &[0.0, a.boost], base, scene, a.streams)?;
     if a.json {
         outln!("{}", serde_json::to_string(&serde_json::json!({ "particles": a.particles, "runs": runs }))?);
         return Ok(());
     }
-    outln!("trajectory  seed  filter        3D RMSE        centre  lost  re-acquired after the full occlusion");
-    let boosted: Vec<f64> = runs.iter().filter(|r| r.boost > 0.0).map(|r| r.scores.rmse_3d_percent_of_depth).collect();
+    outln!("trajectory  seed  stream  filter        3D RMSE        centre  lost  re-acquired after the full occlusion");
     for r in &runs {
         let s = &r.scores;
         outln!(
-            "{:<10} {:>5}  {:<11} {:>6.2} % depth  {:>6.2} px  {:>4}  {}",
+            "{:<10} {:>5}  {:>6}  {:<11} {:>6.2} % depth  {:>6.2} px  {:>4}  {}",
             format!("{:?}", r.trajectory).to_lowercase(),
             r.seed,
+            r.stream,
             if r.boost == 0.0 { "SIR".to_string() } else { format!("boost {}", r.boost) },
             s.rmse_3d_percent_of_depth,
             s.median_centre_error_px,
@@ -540,15 +546,37 @@ fn run_study(a: &StudyArgs) -> Result<()> {
             delays(&s.reacquisition_delays)
         );
     }
-    let mut sorted = boosted.clone();
-    sorted.sort_by(f64::total_cmp);
-    outln!(
-        "boosted: 3D RMSE median {:.2} %, mean {:.2} % of the depth over {} runs",
-        sorted.get(sorted.len() / 2).copied().unwrap_or(0.0),
-        boosted.iter().sum::<f64>() / boosted.len().max(1) as f64,
-        boosted.len()
-    );
+    let summary = |label: String, pick: &dyn Fn(&ocellus_sim::ball_tracking::StudyRun) -> bool| -> Result<()> {
+        let v: Vec<f64> =
+            runs.iter().filter(|r| r.boost > 0.0 && pick(r)).map(|r| r.scores.rmse_3d_percent_of_depth).collect();
+        outln!(
+            "boosted{label}: 3D RMSE median {:.2} %, mean {:.2} % of the depth over {} runs ({} at most 2 %)",
+            median(&v),
+            v.iter().sum::<f64>() / v.len().max(1) as f64,
+            v.len(),
+            v.iter().filter(|&&x| x <= 2.0).count()
+        );
+        Ok(())
+    };
+    summary(String::new(), &|_| true)?;
+    if a.streams > 1 {
+        for k in 0..a.streams {
+            summary(format!(", stream {k}"), &|r| r.stream == k)?;
+        }
+    }
     Ok(())
+}
+
+/// The median (the mean of the two middle values for an even count; 0 when empty).
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    match n {
+        0 => 0.0,
+        _ if n % 2 == 1 => s[n / 2],
+        _ => 0.5 * (s[n / 2 - 1] + s[n / 2]),
+    }
 }
 
 fn run_head_cmd(a: &HeadArgs) -> Result<()> {

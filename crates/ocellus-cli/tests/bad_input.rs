@@ -171,6 +171,7 @@ const CASES: &[Case] = &[
     c("track {D}/frames --radius-m 0.05 --colour 245,120,25 --out {O}", Usage(&["--camera"])),
     c("track eval {D}/missing.csv {D}/missing.csv", Error(&["missing.csv"])),
     c("track study --seeds 1,x", Error(&["--seeds"])),
+    c("track study --streams 0", Usage(&["--streams", "range"])),
     c("track head --steps 0 --out {O}", Usage(&["--steps", "range"])),
     c("track head --particles 0 --out {O}", Usage(&["--particles", "range"])),
     // ---- retina

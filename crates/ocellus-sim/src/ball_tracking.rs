@@ -21,8 +21,12 @@ use ocellus_tracking::tracker::{BallTracker, TrackEstimate, TrackerConfig};
 pub struct StudyRun {
     /// The motion of the ball.
     pub trajectory: Trajectory,
-    /// The world's seed (the filter's is the same).
+    /// The world's seed.
     pub seed: u64,
+    /// The filter's random stream, 0.. (see [`study`]).
+    pub stream: u64,
+    /// The filter's seed ([`filter_seed`] of the world's seed and the stream).
+    pub filter_seed: u64,
     /// The proposal's boost alpha (0: plain SIR).
     pub boost: f64,
     /// The figures.
@@ -122,8 +126,18 @@ pub fn study_world_config(trajectory: Trajectory, seed: u64, scene: StudyScene) 
     }
 }
 
+/// The filter's seed for the world `seed` and random stream `stream`: the world's seed for
+/// stream 0 (the study's default), then seeds far from every world's.
+pub fn filter_seed(seed: u64, stream: u64) -> u64 {
+    seed.wrapping_add(stream.wrapping_mul(1_000_003))
+}
+
 /// Runs every trajectory x seed (worlds holding `scene`) with each boost in `boosts` (0 is the plain SIR), the
-/// tracker otherwise `base`.
+/// tracker otherwise `base`, each `streams` times (at least once) with the filter seeded by
+/// [`filter_seed`]. A tracker's figures on one sequence depend on its random stream as much
+/// as on many a change to it (on the panel's runs the 3D RMSE of a run moves by several
+/// percent of the depth from one stream to the next): compare changes over several streams.
+#[allow(clippy::too_many_arguments)]
 pub fn study(
     background: &Plane<[f32; 3]>,
     occluder: &Plane<[f32; 3]>,
@@ -132,18 +146,22 @@ pub fn study(
     boosts: &[f64],
     base: TrackerConfig,
     scene: StudyScene,
+    streams: u64,
 ) -> Result<Vec<StudyRun>> {
     let mut runs = Vec::new();
     for &trajectory in trajectories {
         for &seed in seeds {
             let wc = study_world_config(trajectory, seed, scene);
             let world = BallWorld::new(wc, background, occluder)?;
-            for &boost in boosts {
-                let mut cfg = tracker_config(&wc, base);
-                cfg.boost = boost;
-                cfg.filter.seed = seed;
-                let (t, e) = track_world(&world, cfg, |_, _, _, _| Ok(()))?;
-                runs.push(StudyRun { trajectory, seed, boost, scores: score_run(&t, &e)? });
+            for stream in 0..streams.max(1) {
+                for &boost in boosts {
+                    let mut cfg = tracker_config(&wc, base);
+                    cfg.boost = boost;
+                    cfg.filter.seed = filter_seed(seed, stream);
+                    let (t, e) = track_world(&world, cfg, |_, _, _, _| Ok(()))?;
+                    let scores = score_run(&t, &e)?;
+                    runs.push(StudyRun { trajectory, seed, stream, filter_seed: cfg.filter.seed, boost, scores });
+                }
             }
         }
     }
