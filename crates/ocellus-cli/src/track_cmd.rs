@@ -547,14 +547,14 @@ fn run_study(a: &StudyArgs) -> Result<()> {
         );
     }
     let summary = |label: String, pick: &dyn Fn(&ocellus_sim::ball_tracking::StudyRun) -> bool| -> Result<()> {
-        let v: Vec<f64> =
-            runs.iter().filter(|r| r.boost > 0.0 && pick(r)).map(|r| r.scores.rmse_3d_percent_of_depth).collect();
+        let s = ocellus_sim::ball_tracking::summarize(runs.iter().filter(|r| r.boost > 0.0 && pick(r)));
         outln!(
-            "boosted{label}: 3D RMSE median {:.2} %, mean {:.2} % of the depth over {} runs ({} at most 2 %)",
-            median(&v),
-            v.iter().sum::<f64>() / v.len().max(1) as f64,
-            v.len(),
-            v.iter().filter(|&&x| x <= 2.0).count()
+            "boosted{label}: 3D RMSE median {:.2} %, mean {:.2} % of the depth over {} runs ({} at most {} %)",
+            s.median_rmse_percent,
+            s.mean_rmse_percent,
+            s.runs,
+            s.within_target,
+            ocellus_sim::ball_tracking::TARGET_RMSE_PERCENT_OF_DEPTH
         );
         Ok(())
     };
@@ -565,18 +565,6 @@ fn run_study(a: &StudyArgs) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// The median (the mean of the two middle values for an even count; 0 when empty).
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let n = s.len();
-    match n {
-        0 => 0.0,
-        _ if n % 2 == 1 => s[n / 2],
-        _ => 0.5 * (s[n / 2 - 1] + s[n / 2]),
-    }
 }
 
 fn run_head_cmd(a: &HeadArgs) -> Result<()> {

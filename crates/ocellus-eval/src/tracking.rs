@@ -54,10 +54,14 @@ pub struct TrackingScores {
     pub reacquisition_delays: Vec<Option<usize>>,
 }
 
-fn median(v: &mut [f64]) -> f64 {
+/// The median of `v` (sorts it): the mean of the two middle values for an even count, 0 for
+/// an empty slice.
+pub fn median(v: &mut [f64]) -> f64 {
     v.sort_by(f64::total_cmp);
     let n = v.len();
-    if n % 2 == 1 {
+    if n == 0 {
+        0.0
+    } else if n % 2 == 1 {
         v[n / 2]
     } else {
         0.5 * (v[n / 2 - 1] + v[n / 2])

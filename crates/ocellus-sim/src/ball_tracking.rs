@@ -9,7 +9,7 @@
 //! and bouncing balls, gravity.
 
 use crate::Result;
-use ocellus_eval::tracking::{score, EstimateFrame, TrackingScores, TruthFrame};
+use ocellus_eval::tracking::{median, score, EstimateFrame, TrackingScores, TruthFrame};
 use ocellus_image::Plane;
 use ocellus_synth::ball_world::{BallTruth, BallWorld, BallWorldConfig, Occlusion, Trajectory, GRAVITY};
 use ocellus_tracking::colour::{Circle, ColourModel};
@@ -126,8 +126,36 @@ pub fn study_world_config(trajectory: Trajectory, seed: u64, scene: StudyScene) 
     }
 }
 
+/// Issue 16's accuracy target: the 3D RMSE of a run at most this share of the mean depth, %.
+pub const TARGET_RMSE_PERCENT_OF_DEPTH: f64 = 2.0;
+
+/// The 3D RMSE over a set of study runs, % of the depth.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct StudySummary {
+    /// Runs summarized.
+    pub runs: usize,
+    /// Median of their 3D RMSE (the mean of the two middle ones for an even count), %.
+    pub median_rmse_percent: f64,
+    /// Mean of their 3D RMSE, %.
+    pub mean_rmse_percent: f64,
+    /// Runs within [`TARGET_RMSE_PERCENT_OF_DEPTH`].
+    pub within_target: usize,
+}
+
+/// Summarizes `runs` (all zero when there are none).
+pub fn summarize<'a>(runs: impl IntoIterator<Item = &'a StudyRun>) -> StudySummary {
+    let mut v: Vec<f64> = runs.into_iter().map(|r| r.scores.rmse_3d_percent_of_depth).collect();
+    StudySummary {
+        runs: v.len(),
+        mean_rmse_percent: v.iter().sum::<f64>() / v.len().max(1) as f64,
+        within_target: v.iter().filter(|&&x| x <= TARGET_RMSE_PERCENT_OF_DEPTH).count(),
+        median_rmse_percent: median(&mut v),
+    }
+}
+
 /// The filter's seed for the world `seed` and random stream `stream`: the world's seed for
-/// stream 0 (the study's default), then seeds far from every world's.
+/// stream 0 (the study's default), then the seed plus a multiple of 1,000,003, far from the
+/// small world seeds a study uses.
 pub fn filter_seed(seed: u64, stream: u64) -> u64 {
     seed.wrapping_add(stream.wrapping_mul(1_000_003))
 }
@@ -166,4 +194,42 @@ pub fn study(
         }
     }
     Ok(runs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_summary_is_the_median_mean_and_count_within_the_target() {
+        let run = |rmse: f64| StudyRun {
+            trajectory: Trajectory::Throw,
+            seed: 1,
+            stream: 0,
+            filter_seed: 1,
+            boost: 0.2,
+            scores: TrackingScores {
+                frames: 60,
+                scored_frames: 46,
+                rmse_3d_m: rmse / 100.0,
+                mean_depth_m: 1.0,
+                rmse_3d_percent_of_depth: rmse,
+                median_centre_error_px: 0.1,
+                lost_frames: 0,
+                reacquisition_delays: vec![Some(0)],
+            },
+        };
+        let runs: Vec<StudyRun> = [4.0, 1.0, 2.0, 9.0].into_iter().map(run).collect();
+        let s = summarize(&runs);
+        assert_eq!((s.runs, s.within_target), (4, 2));
+        assert_eq!((s.median_rmse_percent, s.mean_rmse_percent), (3.0, 4.0));
+        let odd = summarize(&runs[..3]);
+        assert_eq!((odd.median_rmse_percent, odd.within_target), (2.0, 2));
+        assert_eq!(
+            summarize(&runs[..0]),
+            StudySummary { runs: 0, median_rmse_percent: 0.0, mean_rmse_percent: 0.0, within_target: 0 }
+        );
+        assert_eq!(filter_seed(7, 0), 7);
+        assert_ne!(filter_seed(7, 1), filter_seed(8, 0));
+    }
 }
