@@ -259,6 +259,8 @@ pub struct BallDetection {
     pub sigma_lateral_m: f64,
     /// Standard deviation along the line of sight, metres.
     pub sigma_depth_m: f64,
+    /// Whether the blob looked cut by an occluder (its circle from its longer side).
+    pub cut: bool,
 }
 
 /// Two unit vectors orthogonal to `u` and to each other.
@@ -293,6 +295,7 @@ impl BallDetection {
             distance_m: d,
             sigma_lateral_m,
             sigma_depth_m: cfg.depth_sigma_frac * d,
+            cut: circle != blob.area_circle(),
         })
     }
 
@@ -428,6 +431,12 @@ mod tests {
         // Radius 13.6 px: half a pixel of radius is 3.7 % of the depth.
         assert!(err < 0.04 * truth.z, "{ball:?} vs {truth}");
         assert!((ball.circle.x - c.x).abs() < 0.5 && (ball.circle.y - c.y).abs() < 0.5);
+        assert!(!found[0].cut && !ball.cut);
+        // Half hidden, a ball's blob is cut.
+        let c = Circle { x: 300.0, y: 200.0, r: 20.0 };
+        let b = blobs(&BinnedFrame::new(&frame(c, None, true)), model.histogram(), &cfg);
+        let half = b.iter().find(|b| (b.circle.x - c.x).abs() < 2.0 && (b.circle.y - c.y).abs() < 2.0).unwrap();
+        assert!(BallDetection::from_blob(half, &cam, &d, 0.05, &cfg).unwrap().cut);
     }
 
     #[test]
@@ -481,6 +490,7 @@ mod tests {
             distance_m: 2.0,
             sigma_lateral_m: 0.01,
             sigma_depth_m: 0.2,
+            cut: false,
         };
         let mut rng = SplitMix64::new(9);
         // E[-ln q] over samples is the Gaussian's entropy: 1.5 (1 + ln 2 pi) + ln(sl^2 sd).

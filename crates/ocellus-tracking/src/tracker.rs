@@ -405,7 +405,8 @@ impl BallTracker {
     }
 
     /// Starts the filter over from detection `d` in this frame (`self.obs`): positions drawn
-    /// from the detection and weighed by the frame, since its depth is rough; velocities
+    /// from the detection and weighed by the frame, since its depth is rough (unless the
+    /// blob was cut by an occluder); velocities
     /// unknown, drawn about rest (the detector's spread across the line of sight,
     /// `start_velocity_sigma_mps` along it) and drawn again after a resampling. Returns the
     /// ESS.
@@ -425,6 +426,12 @@ impl BallTracker {
             .iter()
             .map(|p| ocellus_estimation::particle_filter::Model::log_likelihood(&self.model, p, &self.obs))
             .collect();
+        // A half-hidden ball's likelihood favours circles in its visible part, too small and
+        // so too far (27 % of the depth on a restart of the generated bounce 2), while a cut
+        // blob's circle, from its longer side, holds the radius: a restart from a cut blob
+        // keeps the detection's spread, unweighed (over the study's 54 runs the mean 3D RMSE
+        // fell from 2.04 % to 1.92 % of the depth, the median stayed 1.75 %).
+        let w = if d.cut { vec![0.0; w.len()] } else { w };
         let report = f.reweight(&w)?;
         if report.resampled {
             let fresh: Vec<BallState> = f
@@ -486,6 +493,7 @@ mod tests {
             distance_m,
             sigma_lateral_m: 0.01,
             sigma_depth_m: 0.1,
+            cut: false,
         };
         // 3 sigma of sqrt(0.01 + 0.01) m: 0.424 m either way.
         assert!(within_gate(&det(2.5), mean, var, 3.0));
