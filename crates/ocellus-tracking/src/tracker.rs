@@ -306,9 +306,7 @@ impl BallTracker {
             // particles move first, and only the part of the frame they can see is binned
             // (their scores are those of the whole frame binned); detection is skipped.
             Some(f) if plain => {
-                let sigma = self.model.motion.accel_sigma;
-                self.model.motion.accel_sigma = sigma * settle_gain(&self.cfg, self.since_start);
-                self.since_start += 1;
+                let sigma = settle(&mut self.model, &self.cfg, &mut self.since_start);
                 let report = self.model.step_in_region(f, frame, &mut self.obs);
                 self.model.motion.accel_sigma = sigma;
                 report?.ess
@@ -388,12 +386,11 @@ impl BallTracker {
                     }
                 }
             }
-            let (alpha, sigma) = (self.model.boost, self.model.motion.accel_sigma);
+            let alpha = self.model.boost;
             if self.lost && !self.obs.detections.is_empty() {
                 self.model.boost = self.cfg.boost_when_lost.max(alpha);
             }
-            self.model.motion.accel_sigma = sigma * settle_gain(&self.cfg, self.since_start);
-            self.since_start += 1;
+            let sigma = settle(&mut self.model, &self.cfg, &mut self.since_start);
             f.propose(&self.model, &self.obs);
             let report = self.model.weigh(f, &self.obs);
             (self.model.boost, self.model.motion.accel_sigma) = (alpha, sigma);
@@ -408,10 +405,9 @@ impl BallTracker {
 
     /// Starts the filter over from detection `d` in this frame (`self.obs`): positions drawn
     /// from the detection and weighed by the frame, since its depth is rough (unless the
-    /// blob was cut by an occluder); velocities
-    /// unknown, drawn about rest (the detector's spread across the line of sight,
-    /// `start_velocity_sigma_mps` along it) and drawn again after a resampling. Returns the
-    /// ESS.
+    /// blob was cut by an occluder); velocities unknown, drawn about rest (the detector's
+    /// spread across the line of sight, `start_velocity_sigma_mps` along it) and drawn again
+    /// after a resampling. Returns the ESS.
     fn start_from(&mut self, d: &BallDetection) -> Result<f64> {
         let seed = self.cfg.filter.seed ^ 0x5EED_BA11 ^ (self.frame as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
         let mut rng = SplitMix64::new(seed);
@@ -423,17 +419,22 @@ impl BallTracker {
             })
             .collect();
         let mut f = ParticleFilter::new(self.cfg.filter, particles)?;
-        let w: Vec<f64> = f
-            .particles()
-            .iter()
-            .map(|p| ocellus_estimation::particle_filter::Model::log_likelihood(&self.model, p, &self.obs))
-            .collect();
+        self.since_start = 0;
         // A half-hidden ball's likelihood favours circles in its visible part, too small and
         // so too far (27 % of the depth on a restart of the generated bounce 2), while a cut
         // blob's circle, from its longer side, holds the radius: a restart from a cut blob
         // keeps the detection's spread, unweighed (over the study's 54 runs the mean 3D RMSE
         // fell from 2.04 % to 1.92 % of the depth, the median stayed 1.75 %).
-        let w = if d.cut { vec![0.0; w.len()] } else { w };
+        if d.cut {
+            let ess = f.ess();
+            self.filter = Some(f);
+            return Ok(ess);
+        }
+        let w: Vec<f64> = f
+            .particles()
+            .iter()
+            .map(|p| ocellus_estimation::particle_filter::Model::log_likelihood(&self.model, p, &self.obs))
+            .collect();
         let report = f.reweight(&w)?;
         if report.resampled {
             let fresh: Vec<BallState> = f
@@ -447,9 +448,17 @@ impl BallTracker {
             f.reset(fresh)?;
         }
         self.filter = Some(f);
-        self.since_start = 0;
         Ok(report.ess)
     }
+}
+
+/// Raises `model`'s acceleration noise for the step after `since_start` steps since a
+/// (re)start ([`settle_gain`]) and counts the step; returns the noise to restore after it.
+fn settle(model: &mut BallModel, cfg: &TrackerConfig, since_start: &mut usize) -> f64 {
+    let sigma = model.motion.accel_sigma;
+    model.motion.accel_sigma = sigma * settle_gain(cfg, *since_start);
+    *since_start += 1;
+    sigma
 }
 
 /// The factor on the acceleration noise `steps` steps after a (re)start: `settle_noise_gain`
