@@ -47,6 +47,7 @@ fn scene() -> Result<(Plane<[u8; 3]>, BallModel, Vector3<f64>)> {
         boost: 0.0,
         detection_velocity_sigma_mps: [3.0, 0.5],
         evidence_score: TrackerConfig::at_fps(30.0).evidence_score,
+        cut_sigma_px: 0.0,
     };
     Ok((frame, model, ball))
 }
