@@ -96,19 +96,17 @@ pub struct ParticleFilter<S> {
 
 /// A generator for (seed, step, stream): SplitMix64 of a mixed key, so streams do not overlap
 /// in practice.
+/// Particles per chunk of the weight update's parallel passes. Fixed, not set by the thread
+/// count, so that the partial sums, added in chunk order, and with them every weight, come out
+/// the same bit for bit with one thread or many. The update was the serial part of a step
+/// (three passes of `exp` over the cloud): with it serial, 10^4 particles on 2 cores ran
+/// 1.78 times as fast as on one.
+const WEIGH_CHUNK: usize = 4096;
+
 fn stream(seed: u64, step: u64, index: u64) -> SplitMix64 {
     let mut k = SplitMix64::new(seed ^ step.wrapping_mul(0x9E37_79B9_7F4A_7C15));
     let base = k.next_u64();
     SplitMix64::new(base ^ index.wrapping_mul(0xD1B5_4A32_D192_ED03))
-}
-
-/// `log(sum exp(v))`, `-inf` for all `-inf`.
-fn log_sum_exp(v: &[f64]) -> f64 {
-    let m = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if m == f64::NEG_INFINITY {
-        return m;
-    }
-    m + v.iter().map(|x| (x - m).exp()).sum::<f64>().ln()
 }
 
 impl<S: Clone + Send + Sync> ParticleFilter<S> {
@@ -247,9 +245,7 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
         self.likelihoods.clear();
         self.likelihoods.resize(self.particles.len(), 0.0);
         log_likelihoods(&self.particles, &mut self.likelihoods);
-        for (inc, l) in self.increments.iter_mut().zip(&self.likelihoods) {
-            *inc += l;
-        }
+        self.increments.par_iter_mut().zip(self.likelihoods.par_iter()).for_each(|(inc, l)| *inc += l);
         self.steps += 1;
         self.weigh()
     }
@@ -280,46 +276,87 @@ impl<S: Clone + Send + Sync> ParticleFilter<S> {
         self.weigh()
     }
 
-    /// Applies `self.increments` to the log weights, normalizes, resamples if due.
+    /// Applies `self.increments` to the log weights, normalizes, resamples if due. One pass
+    /// of `exp` gives the log evidence, the normalized weights and the ESS, in parallel
+    /// over fixed chunks ([`WEIGH_CHUNK`]).
     fn weigh(&mut self) -> Result<StepReport> {
         let n = self.particles.len();
-        if self.increments.iter().any(|v| v.is_nan()) {
+        if self.increments.par_iter().any(|v| v.is_nan()) {
             return Err(EstimationError::InvalidInput("the model gave a NaN log weight".into()));
         }
-        for (w, inc) in self.log_w.iter_mut().zip(&self.increments) {
-            *w += inc;
-        }
-        // The log evidence: log sum_i w_i' exp(inc_i), the previous weights being normalized.
-        let total = log_sum_exp(&self.log_w);
+        self.log_w.par_iter_mut().zip(self.increments.par_iter()).for_each(|(w, inc)| *w += inc);
+        // The log evidence: log sum_i w_i' exp(inc_i), the previous weights being normalized;
+        // computed as m + log sum_i exp(l_i - m) with m the largest log weight.
+        let m = self.log_w.par_iter().copied().reduce(|| f64::NEG_INFINITY, f64::max);
+        self.weights.resize(n, 0.0);
+        let sums: Vec<f64> = if m.is_finite() {
+            self.weights
+                .par_chunks_mut(WEIGH_CHUNK)
+                .zip(self.log_w.par_chunks(WEIGH_CHUNK))
+                .map(|(e, l)| {
+                    let mut s = 0.0;
+                    for (e, l) in e.iter_mut().zip(l) {
+                        *e = (l - m).exp();
+                        s += *e;
+                    }
+                    s
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let sum: f64 = sums.iter().sum();
+        let total = m + sum.ln();
         if !total.is_finite() {
             let lw = -(n as f64).ln();
-            self.log_w.iter_mut().for_each(|l| *l = lw);
+            self.log_w.par_iter_mut().for_each(|l| *l = lw);
             return Ok(StepReport { ess: n as f64, resampled: false, log_evidence: f64::NEG_INFINITY });
         }
-        self.log_w.iter_mut().for_each(|l| *l -= total);
-        let ess = self.ess();
+        let inv = 1.0 / sum;
+        let squares: Vec<f64> = self
+            .weights
+            .par_chunks_mut(WEIGH_CHUNK)
+            .zip(self.log_w.par_chunks_mut(WEIGH_CHUNK))
+            .map(|(w, l)| {
+                let mut q = 0.0;
+                for (w, l) in w.iter_mut().zip(l.iter_mut()) {
+                    *l -= total;
+                    *w *= inv;
+                    q += *w * *w;
+                }
+                q
+            })
+            .collect();
+        let q: f64 = squares.iter().sum();
+        let ess = if q > 0.0 { 1.0 / q } else { 0.0 };
         let resampled = ess < self.cfg.resample_below * n as f64;
         if resampled {
-            self.resample()?;
+            self.resample_by_weights()?;
         }
         Ok(StepReport { ess, resampled, log_evidence: total })
     }
 
     /// Resamples now with the configured scheme; the weights become equal.
     pub fn resample(&mut self) -> Result<()> {
-        let n = self.particles.len();
         self.weights.clear();
-        self.weights.extend(self.log_w.iter().map(|l| l.exp()));
+        self.weights.par_extend(self.log_w.par_iter().map(|l| l.exp()));
         // exp of normalized logs sums to 1 within round-off; renormalize for the check.
         let s: f64 = self.weights.iter().sum();
-        self.weights.iter_mut().for_each(|w| *w /= s);
+        self.weights.par_iter_mut().for_each(|w| *w /= s);
+        self.resample_by_weights()
+    }
+
+    /// Resamples by `self.weights` (normalized, one per particle); the weights become equal.
+    fn resample_by_weights(&mut self) -> Result<()> {
+        let n = self.particles.len();
         let mut rng = stream(self.cfg.seed, self.steps, u64::MAX);
         self.cfg.resampler.resample(&self.weights, &mut rng, &mut self.parents)?;
         self.next.clear();
-        self.next.extend(self.parents.iter().map(|&p| self.particles[p].clone()));
+        let particles = &self.particles;
+        self.next.par_extend(self.parents.par_iter().map(|&p| particles[p].clone()));
         std::mem::swap(&mut self.particles, &mut self.next);
         let lw = -(n as f64).ln();
-        self.log_w.iter_mut().for_each(|l| *l = lw);
+        self.log_w.par_iter_mut().for_each(|l| *l = lw);
         Ok(())
     }
 }
@@ -464,20 +501,23 @@ mod tests {
     #[test]
     fn same_seed_same_particles_with_one_thread_or_many() {
         let m = Walk { step_sigma: 0.3, obs_sigma: 0.2, pull: 0.2 };
-        let run = |threads: usize| {
+        // 5000 particles: the weight update's sums run over two chunks. Resampling every
+        // step, and only below half the ESS (the log weights then carry over).
+        let run = |threads: usize, resample_below: f64| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let cfg = FilterConfig { resample_below: 1.0, resampler: Resampler::Residual, seed: 9 };
+                let cfg = FilterConfig { resample_below, resampler: Resampler::Residual, seed: 9 };
                 let mut f = ParticleFilter::new(cfg, (0..5000).map(|i| i as f64 * 1e-3).collect()).unwrap();
-                for k in 0..20 {
-                    f.step(&m, &(k as f64 * 0.1)).unwrap();
-                }
-                (f.particles().to_vec(), f.log_weights().to_vec())
+                let ess: Vec<f64> = (0..20).map(|k| f.step(&m, &(k as f64 * 0.1)).unwrap().ess).collect();
+                (f.particles().to_vec(), f.log_weights().to_vec(), ess)
             })
         };
-        let one = run(1);
-        assert_eq!(one, run(4));
-        assert_eq!(one, run(1));
+        for r in [1.0, 0.5] {
+            let one = run(1, r);
+            assert_eq!(one, run(4, r));
+            assert_eq!(one, run(3, r));
+            assert_eq!(one, run(1, r));
+        }
     }
 
     #[test]
