@@ -4,8 +4,16 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
 use ocellus_sim::ball_tracking::{score_run, study_world_config, track_world, tracker_config, StudyScene};
-use ocellus_synth::ball_world::{BallWorld, Trajectory};
+use ocellus_synth::ball_world::{BallWorld, BallWorldConfig, Trajectory};
 use ocellus_tracking::tracker::TrackerConfig;
+
+/// The study's world of `trajectory` and `seed` with both occluders, over the rocket photo.
+fn study_world(trajectory: Trajectory, seed: u64) -> (BallWorldConfig, BallWorld) {
+    let load =
+        |n: &str| ocellus_io::read_image(ocellus_testdata::data_file(n)).unwrap().to_u8().map(|p| p.map(f32::from));
+    let wc = study_world_config(trajectory, seed, StudyScene::default());
+    (wc, BallWorld::new(wc, &load("rocket.jpg"), &load("gravel.png")).unwrap())
+}
 
 /// Approach 3 with both occluders: the ball comes nearest (1.3 m) while behind the panel and
 /// comes out of it receding at about 2.5 m/s, where it went in approaching. The coasted
@@ -13,10 +21,7 @@ use ocellus_tracking::tracker::TrackerConfig;
 /// velocities and a raised acceleration noise while they settle, reads the new one.
 #[test]
 fn a_ball_that_turns_while_hidden_is_found_again_with_its_new_velocity() {
-    let load =
-        |n: &str| ocellus_io::read_image(ocellus_testdata::data_file(n)).unwrap().to_u8().map(|p| p.map(f32::from));
-    let wc = study_world_config(Trajectory::Approach, 3, StudyScene::default());
-    let world = BallWorld::new(wc, &load("rocket.jpg"), &load("gravel.png")).unwrap();
+    let (wc, world) = study_world(Trajectory::Approach, 3);
     let rmse = |cfg: TrackerConfig| {
         let (t, e) = track_world(&world, cfg, |_, _, _, _| Ok(())).unwrap();
         score_run(&t, &e).unwrap().rmse_3d_percent_of_depth
@@ -36,10 +41,7 @@ fn a_ball_that_turns_while_hidden_is_found_again_with_its_new_velocity() {
 /// part, too far away; the cut blob's circle, weighed as an observation, holds it.
 #[test]
 fn a_ball_coming_out_from_behind_a_panel_is_placed_by_its_cut_blob() {
-    let load =
-        |n: &str| ocellus_io::read_image(ocellus_testdata::data_file(n)).unwrap().to_u8().map(|p| p.map(f32::from));
-    let wc = study_world_config(Trajectory::Bounce, 1, StudyScene::default());
-    let world = BallWorld::new(wc, &load("rocket.jpg"), &load("gravel.png")).unwrap();
+    let (wc, world) = study_world(Trajectory::Bounce, 1);
     // The worst depth error, % of the distance, over the frames after the panel with the ball
     // more than half but not wholly visible; and the run's 3D RMSE.
     let run = |cfg: TrackerConfig| {
