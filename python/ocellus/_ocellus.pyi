@@ -146,7 +146,7 @@ class BallTracker:
         colour: Optional[Tuple[int, int, int]] = None,
         patch: Optional[Tuple[Image, float, float, float]] = None,
         distortion: Optional[Sequence[float]] = None,
-        particles: int = 4000,
+        particles: int = 16000,
         boost: float = 0.2,
         fps: float = 30.0,
         seed: int = 1,

@@ -190,7 +190,7 @@ impl ParticleFilter {
 /// The 3D ball tracker (SPEC 7.3, 7.4): a particle filter over the ball's centre and
 /// velocity in the camera frame (metres, y down), weighed by the colour likelihood of its
 /// image circle, boosted by colour-blob detections. `BallTracker(K, radius_m, colour=None,
-/// patch=None, distortion=None, particles=4000, boost=0.2, fps=30.0, seed=1, gravity=0.0,
+/// patch=None, distortion=None, particles=16000, boost=0.2, fps=30.0, seed=1, gravity=0.0,
 /// accel_sigma=10.0, floor_y=None, restitution=0.8)`: the colour model is one RGB colour
 /// (`colour`), or the disc `patch` = (image, x, y, r) of a frame; `distortion` in OpenCV's
 /// order (k1, k2, p1, p2[, k3]); `gravity` m/s^2 along y; `floor_y` the level floor's y.
@@ -202,7 +202,7 @@ struct BallTracker {
 #[pymethods]
 impl BallTracker {
     #[new]
-    #[pyo3(signature = (k, radius_m, colour = None, patch = None, distortion = None, particles = 4000, boost = 0.2,
+    #[pyo3(signature = (k, radius_m, colour = None, patch = None, distortion = None, particles = 16000, boost = 0.2,
                         fps = 30.0, seed = 1, gravity = 0.0, accel_sigma = 10.0, floor_y = None, restitution = 0.8))]
     #[allow(clippy::too_many_arguments)]
     fn new(

@@ -17,7 +17,7 @@ use ocellus_sim::ball_tracking::study;
 use ocellus_synth::ball_world::Trajectory;
 use ocellus_tracking::colour::{Circle, ColourModel};
 use ocellus_tracking::motion::Floor;
-use ocellus_tracking::tracker::{BallTracker, TrackEstimate, TrackerConfig, MAX_PARTICLES};
+use ocellus_tracking::tracker::{BallTracker, TrackEstimate, TrackerConfig, DEFAULT_PARTICLES, MAX_PARTICLES};
 use plotters::style::RGBColor;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -45,7 +45,7 @@ pub struct TrackArgs {
     #[arg(long)]
     colour: Option<String>,
     /// Number of particles. Range: 1..=2000000.
-    #[arg(long, default_value_t = 4000, value_parser = ranges::within(1usize, MAX_PARTICLES))]
+    #[arg(long, default_value_t = DEFAULT_PARTICLES, value_parser = ranges::within(1usize, MAX_PARTICLES))]
     particles: usize,
     /// Share alpha of particles drawn from colour-blob detections (0: plain SIR). Range: 0..=1.
     #[arg(long, default_value_t = 0.2, value_parser = ranges::within(0.0f64, 1.0))]
@@ -141,7 +141,7 @@ struct StudyArgs {
     #[arg(long, default_value = "1,2,3")]
     seeds: String,
     /// Particles. Range: 1..=2000000.
-    #[arg(long, default_value_t = 4000, value_parser = ranges::within(1usize, MAX_PARTICLES))]
+    #[arg(long, default_value_t = DEFAULT_PARTICLES, value_parser = ranges::within(1usize, MAX_PARTICLES))]
     particles: usize,
     /// Boost alpha of the boosted filter. Range: above 0, at most 1.
     #[arg(long, default_value_t = 0.2, value_parser = ranges::above(0.0f64, 1.0))]
