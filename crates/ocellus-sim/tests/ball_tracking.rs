@@ -18,10 +18,9 @@ fn study_world(trajectory: Trajectory, seed: u64) -> (BallWorldConfig, BallWorld
 /// Approach 3 with both occluders: the ball comes nearest (1.3 m) while behind the panel and
 /// comes out of it receding at about 2.5 m/s, where it went in approaching. The coasted
 /// cloud's velocities point the wrong way; a restart from the detection, with unknown
-/// velocities and a raised acceleration noise while they settle, reads the new one. With
-/// 4000 particles, where the old way loses most: with the default 16000 the carried cloud
-/// more often holds a particle near the ball's new course (1.79 % of the depth against the
-/// restart's 1.01 %).
+/// velocities and a raised acceleration noise while they settle, reads the new one. (With
+/// 4000 particles, the default until 2026-12-05, the carried cloud was 10.6 % off; with the
+/// default 16000 it more often holds a particle near the ball's new course.)
 #[test]
 fn a_ball_that_turns_while_hidden_is_found_again_with_its_new_velocity() {
     let (wc, world) = study_world(Trajectory::Approach, 3);
@@ -29,13 +28,13 @@ fn a_ball_that_turns_while_hidden_is_found_again_with_its_new_velocity() {
         let (t, e) = track_world(&world, cfg, |_, _, _, _| Ok(())).unwrap();
         score_run(&t, &e).unwrap().rmse_3d_percent_of_depth
     };
-    let cfg = tracker_config(&wc, TrackerConfig { particles: 4000, ..TrackerConfig::at_fps(wc.fps) });
+    let cfg = tracker_config(&wc, TrackerConfig::at_fps(wc.fps));
     let restarted = rmse(cfg);
     // Re-acquired by drawing the whole proposal from the detection, weighed against the
     // coasted cloud's motion prior, as before the restart.
     let carried = rmse(TrackerConfig { restart_when_lost: false, settle_frames: 0, ..cfg });
     println!("3D RMSE {restarted:.2} % of the depth restarted, {carried:.2} % carried on");
-    assert!(restarted <= 2.5, "{restarted} %");
+    assert!(restarted <= 2.0, "{restarted} %");
     assert!(carried >= 2.0 * restarted, "{carried} % against {restarted} %");
 }
 

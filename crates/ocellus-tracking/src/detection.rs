@@ -54,6 +54,30 @@ pub struct DetectorConfig {
     /// The same along the line of sight, m/s: narrow, since the image hardly sees it (a wide
     /// one lets the depth run away after a bounce).
     pub velocity_sigma_along_mps: f64,
+    /// Added to the radius of a cut blob's circle (half its longer side), pixels, in [0, 2]:
+    /// the ball's limb is darkened by its shading and its last pixels fail the colour test,
+    /// so the blob's box falls short of the ball's edge at both ends (see
+    /// [`DEFAULT_CUT_EDGE_INSET_PX`]).
+    #[serde(default = "default_cut_edge_inset_px")]
+    pub cut_edge_inset_px: f64,
+}
+
+/// Default of [`DetectorConfig::cut_edge_inset_px`], pixels. On the generated sequences
+/// (Lambert-shaded balls of radius 9-23 px) the radii of cut blobs from their boxes were 0.3
+/// px short of the truth on average (0.0-0.7 px over 11 frames of bounce 2 and approach 2),
+/// as were those of whole blobs from their areas (0.25-0.37 px). With the round side and the
+/// radius moved out by this inset, the 54 runs of `ocellus track study --seeds
+/// 1,2,3,4,5,6 --streams 3` (16000 particles) had a median 3D RMSE of 1.01 % of the depth, a
+/// mean of 1.03 % and a worst run of 1.45 % (all 54 within 2 %), against 1.07 / 1.16 / 3.03 %
+/// (53) without. A variant tried first kept the round side at the box's edge and grew only
+/// the radius: insets of 0.2 / 0.3 / 0.5 px gave means of 1.04 / 0.98 / 1.10 % and worst runs
+/// of 2.04 / 1.57 / 1.86 %. Growing whole blobs' radii too changed little (mean 1.00 %): their
+/// depth is drawn with a spread of 12 %, while a cut blob's circle is weighed as an
+/// observation with a spread of 0.65 px and starts the cloud after a loss.
+pub const DEFAULT_CUT_EDGE_INSET_PX: f64 = 0.3;
+
+fn default_cut_edge_inset_px() -> f64 {
+    DEFAULT_CUT_EDGE_INSET_PX
 }
 
 impl Default for DetectorConfig {
@@ -68,6 +92,7 @@ impl Default for DetectorConfig {
             depth_sigma_frac: 0.12,
             velocity_sigma_across_mps: 3.0,
             velocity_sigma_along_mps: 0.5,
+            cut_edge_inset_px: DEFAULT_CUT_EDGE_INSET_PX,
         }
     }
 }
@@ -91,6 +116,12 @@ impl DetectorConfig {
         }
         if !(self.min_score.is_finite() && (-1.0..=1.0).contains(&self.min_score)) {
             return Err(TrackingError::Invalid(format!("detector min_score {} is outside [-1, 1]", self.min_score)));
+        }
+        if !(self.cut_edge_inset_px.is_finite() && (0.0..=2.0).contains(&self.cut_edge_inset_px)) {
+            return Err(TrackingError::Invalid(format!(
+                "detector cut_edge_inset_px {} is outside [0, 2] px",
+                self.cut_edge_inset_px
+            )));
         }
         if self.min_area_px == 0 {
             return Err(TrackingError::Invalid("detector min_area_px must be at least 1".into()));
@@ -126,15 +157,23 @@ fn area_circle(area_px: usize, centroid: [f64; 2]) -> Circle {
 }
 
 /// The ball's circle for a blob of `area_px` pixels about `centroid` within `bbox`, whose
-/// pixels are those where `on(x, y)` holds (see the module doc).
-fn fit_circle(area_px: usize, centroid: [f64; 2], bbox: [usize; 4], on: impl Fn(usize, usize) -> bool) -> Circle {
+/// pixels are those where `on(x, y)` holds (see the module doc); a cut blob's radius is
+/// grown by `inset` pixels ([`DetectorConfig::cut_edge_inset_px`]).
+fn fit_circle(
+    area_px: usize,
+    centroid: [f64; 2],
+    bbox: [usize; 4],
+    inset: f64,
+    on: impl Fn(usize, usize) -> bool,
+) -> Circle {
     let disc = area_circle(area_px, centroid);
     let [x0, y0, x1, y1] = bbox.map(|v| v as f64);
     let (wx, wy) = (x1 - x0 + 1.0, y1 - y0 + 1.0);
-    let r = wx.max(wy) / 2.0;
-    if r <= 1.15 * disc.r {
+    let half = wx.max(wy) / 2.0;
+    if half <= 1.15 * disc.r {
         return disc;
     }
+    let r = half + inset;
     // Cut by an occluder's edge: the longer side spans the whole ball, and across it the
     // round side lies one radius from the centre, at one end of the box or the other. Of
     // the two circles, the ball's is the one that holds more of the blob. (A ball more than
@@ -145,10 +184,10 @@ fn fit_circle(area_px: usize, centroid: [f64; 2], bbox: [usize; 4], on: impl Fn(
     // lies nearer the cut.
     let (lo_first, centre) = if wx >= wy {
         let c = |yc: f64| Circle { x: 0.5 * (x0 + x1), y: yc, r };
-        ((c(y0 - 0.5 + r), c(y1 + 0.5 - r)), centroid[1] > 0.5 * (y0 + y1))
+        ((c(y0 - 0.5 - inset + r), c(y1 + 0.5 + inset - r)), centroid[1] > 0.5 * (y0 + y1))
     } else {
         let c = |xc: f64| Circle { x: xc, y: 0.5 * (y0 + y1), r };
-        ((c(x0 - 0.5 + r), c(x1 + 0.5 - r)), centroid[0] > 0.5 * (x0 + x1))
+        ((c(x0 - 0.5 - inset + r), c(x1 + 0.5 + inset - r)), centroid[0] > 0.5 * (x0 + x1))
     };
     let (round_at_lo, round_at_hi) = lo_first;
     let held = |c: &Circle| {
@@ -234,7 +273,7 @@ pub fn blobs(frame: &BinnedFrame, model: &Histogram, cfg: &DetectorConfig) -> Ve
                 let l = label[y * w + x];
                 l != u32::MAX && roots[l as usize] as usize == root
             };
-            Blob { area_px: n, centroid, bbox, circle: fit_circle(n, centroid, bbox, on) }
+            Blob { area_px: n, centroid, bbox, circle: fit_circle(n, centroid, bbox, cfg.cut_edge_inset_px, on) }
         })
         .filter(|b| b.area_px as f64 >= cfg.min_fill * std::f64::consts::PI * b.circle.r * b.circle.r)
         .collect();
@@ -455,6 +494,22 @@ mod tests {
     }
 
     #[test]
+    fn the_edge_inset_grows_a_cut_blob_about_the_same_centre_and_leaves_whole_blobs() {
+        let model = crate::colour::ColourModel::from_colour([240, 118, 22]);
+        let c = Circle { x: 300.0, y: 200.0, r: 20.0 };
+        let at = |hide: bool, inset: f64| {
+            let cfg = DetectorConfig { cut_edge_inset_px: inset, ..DetectorConfig::default() };
+            let b = blobs(&BinnedFrame::new(&frame(c, None, hide)), model.histogram(), &cfg);
+            b.iter().map(|b| b.circle).find(|c| (c.x - 300.0).abs() < 20.0 && (c.y - 200.0).abs() < 20.0).unwrap()
+        };
+        // The round side moves out with the radius: the centre stays where the box puts it.
+        let (bare, grown) = (at(true, 0.0), at(true, 0.3));
+        assert!((grown.r - bare.r - 0.3).abs() < 1e-12, "{bare:?} {grown:?}");
+        assert_eq!((grown.x, grown.y), (bare.x, bare.y));
+        assert_eq!(at(false, 0.0), at(false, 0.3));
+    }
+
+    #[test]
     fn a_ball_more_than_half_visible_is_placed_by_the_blob_it_covers() {
         // A panel hides the ball right of x = 306 down to y = 212, below which a sliver of
         // its lower right shows: the blob's box spans 280..=316 across (the round left side
@@ -509,6 +564,9 @@ mod tests {
             DetectorConfig { min_fill: f64::NAN, ..ok },
             DetectorConfig { depth_sigma_frac: -0.1, ..ok },
             DetectorConfig { min_area_px: 0, ..ok },
+            DetectorConfig { cut_edge_inset_px: f64::NAN, ..ok },
+            DetectorConfig { cut_edge_inset_px: -0.1, ..ok },
+            DetectorConfig { cut_edge_inset_px: 2.5, ..ok },
         ] {
             assert!(c.validate().is_err(), "{c:?}");
         }
