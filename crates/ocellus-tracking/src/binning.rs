@@ -6,6 +6,7 @@
 //! coefficient.
 
 use ocellus_image::{Backend, Plane};
+use rayon::prelude::*;
 
 /// Hue bins of the hue-saturation part.
 pub const HUE_BINS: usize = 10;
@@ -161,18 +162,20 @@ unsafe fn bin_row_avx2(src: &[[u8; 3]], dst: &mut [u8]) -> usize {
     i
 }
 
-/// Bins the pixels of `frame` in columns `x0..x1` of rows `y0..y1` into `out` (same size as
-/// the frame; the caller clamps the rectangle to it). `M` only selects the build (the kernel
-/// has no multiply-add); [`ocellus_image::dispatch_kernel!`] compiles it with AVX2.
+/// Bins the pixels of `frame` in columns `x0..x1` of rows `y0..y1` into `rows`, which holds
+/// those rows of the bin plane (row `y` at `(y - y0) * w`, `w` the frame's width; the
+/// caller clamps the rectangle to the frame). `M` only selects the build (the kernel has no
+/// multiply-add); [`ocellus_image::dispatch_kernel!`] compiles it with AVX2.
 #[allow(clippy::extra_unused_type_parameters)]
 #[inline(always)]
-fn bin_rect_generic<M: ocellus_image::simd::Madd>(
+fn bin_rows_generic<M: ocellus_image::simd::Madd>(
     frame: &Plane<[u8; 3]>,
-    out: &mut Plane<u8>,
+    rows: &mut [u8],
+    w: usize,
     [x0, y0, x1, y1]: [usize; 4],
 ) {
-    for y in y0..y1 {
-        let (src, dst) = (&frame.row(y)[x0..x1], &mut out.row_mut(y)[x0..x1]);
+    for (y, out) in (y0..y1).zip(rows.chunks_exact_mut(w)) {
+        let (src, dst) = (&frame.row(y)[x0..x1], &mut out[x0..x1]);
         #[cfg(target_arch = "x86_64")]
         let (src, dst) = if M::AVX2 {
             // SAFETY: M::AVX2 is only instantiated inside functions compiled with AVX2.
@@ -192,10 +195,38 @@ fn bin_rect_generic<M: ocellus_image::simd::Madd>(
 }
 
 ocellus_image::dispatch_kernel!(
-    /// Bins a rectangle of a frame (the caller sizes `out` and clamps the rectangle), with
-    /// the backend's kernel.
-    fn bin_rect => bin_rect_generic(frame: &Plane<[u8; 3]>, out: &mut Plane<u8>, rect: [usize; 4])
+    /// Bins a band of rows of a frame (see [`bin_rows_generic`]) with the backend's kernel.
+    fn bin_rows => bin_rows_generic(frame: &Plane<[u8; 3]>, rows: &mut [u8], w: usize, rect: [usize; 4])
 );
+
+/// Pixels per task of [`bin_rect`]: about 10 us of binning, so that the tasks outweigh
+/// rayon's cost of handing them out, and a 640x480 frame still makes 37 of them.
+const BIN_TASK_PIXELS: usize = 8192;
+
+/// Bins the rectangle [x0, y0, x1, y1) of `frame` (clamped by the caller) into `out` (the
+/// frame's size), in bands of rows on the rayon pool: the bins are per pixel, so the result
+/// is the same at any thread count. Binning was the one serial stage of a tracker step, and
+/// at 10^4 particles on 2 cores it held the speed-up to about 1.75x.
+fn bin_rect(backend: Backend, frame: &Plane<[u8; 3]>, out: &mut Plane<u8>, [x0, y0, x1, y1]: [usize; 4]) {
+    let w = out.width();
+    if x0 >= x1 || y0 >= y1 {
+        return;
+    }
+    let band = (BIN_TASK_PIXELS / (x1 - x0)).max(1);
+    match out.as_contiguous_mut() {
+        Some(all) => all[y0 * w..y1 * w].par_chunks_mut(band * w).enumerate().for_each(|(i, rows)| {
+            let ya = y0 + i * band;
+            bin_rows(backend, frame, rows, w, [x0, ya, x1, (ya + band).min(y1)]);
+        }),
+        // The bin plane is always contiguous (`Plane::resize` sets stride = width); a strided
+        // one is binned row by row.
+        None => {
+            for y in y0..y1 {
+                bin_rows(backend, frame, out.row_mut(y), w, [x0, y, x1, y + 1]);
+            }
+        }
+    }
+}
 
 /// A frame's pixels as histogram bins, computed once per frame: the whole frame, or only the
 /// region a set of hypotheses can read ([`BinnedFrame::update_region`]).
@@ -411,6 +442,30 @@ mod tests {
                     for g in 0..256 {
                         let want = bin_of([r, g as u8, b as u8]);
                         assert_eq!(bf.bins().get(g, b), want, "{backend:?} ({r}, {g}, {b})");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_region_binned_in_bands_on_any_pool_is_the_per_pixel_definition() {
+        // 283 columns: bands of 28 rows from row 3, the last one partial; outside the
+        // rectangle the bins stay as they were (0).
+        let frame = Plane::from_fn(300, 200, |x, y| [(x * 7 + y) as u8, (y * 5) as u8, (x * 3 + y * 11) as u8]);
+        let rect = [7, 3, 290, 197];
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            for backend in Backend::available() {
+                let mut b = BinnedFrame::default();
+                b.bins.resize(300, 200);
+                b.bins.fill(0);
+                pool.install(|| b.update_region_with(backend, &frame, rect));
+                for y in 0..200 {
+                    for x in 0..300 {
+                        let inside = (7..290).contains(&x) && (3..197).contains(&y);
+                        let want = if inside { bin_of(frame.get(x, y)) } else { 0 };
+                        assert_eq!(b.bins().get(x, y), want, "{threads} threads {backend:?} ({x}, {y})");
                     }
                 }
             }

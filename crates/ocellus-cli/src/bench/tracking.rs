@@ -98,14 +98,21 @@ fn cloud(n: usize, ball: &Vector3<f64>) -> Result<ParticleFilter<BallState>> {
 }
 
 /// Rounds of [`speedup`].
-const SPEEDUP_ROUNDS: usize = 41;
+const SPEEDUP_ROUNDS: usize = 15;
 
-/// The SIR step of `n` particles on one thread and on `threads`, timed in alternation: each
-/// of [`SPEEDUP_ROUNDS`] rounds times one step of each of two identical filters (the same
-/// particles at every round, as the filter's result does not depend on the thread count).
-/// Returns the median milliseconds on `threads` and the median of the rounds' ratios (one
-/// thread's time over theirs): on a shared machine a burst of load then falls on both sides of one round,
-/// not on all of one side's steps, as it did when the two were timed one after the other.
+/// Timed steps per side of a round of [`speedup`], after one untimed.
+const SPEEDUP_BLOCK: usize = 8;
+
+/// The SIR step of `n` particles on one thread and on `threads`, timed in alternating
+/// blocks: each of [`SPEEDUP_ROUNDS`] rounds runs [`SPEEDUP_BLOCK`] steps (after one untimed)
+/// of one filter on one thread, then as many of an identical filter on `threads` (both
+/// filters go through the same particles, as the result does not depend on the thread
+/// count). Returns the median milliseconds on `threads` and the median of the rounds'
+/// ratios of block medians (one thread over `threads`). Alternating rounds put a burst of
+/// load from elsewhere on both sides of a round, not on all of one side, as when the sides
+/// were timed one after the other; blocks, not single steps, because a pool left idle puts
+/// its threads to sleep, and waking them cost up to 2 ms a step on this 2-vCPU VM when the
+/// sides took turns step by step (the speed-up then read 1.3-1.9x).
 fn speedup(
     n: usize,
     threads: usize,
@@ -117,18 +124,23 @@ fn speedup(
     let all_pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
     let (mut a, mut b) = (cloud(n, ball)?, cloud(n, ball)?);
     let (mut oa, mut ob) = (BallFrame::default(), BallFrame::default());
+    let block = |pool: &rayon::ThreadPool, pf: &mut ParticleFilter<BallState>, obs: &mut BallFrame| {
+        pool.install(|| -> Result<f64> {
+            model.step_in_region(pf, frame, obs)?;
+            let mut t = (0..SPEEDUP_BLOCK)
+                .map(|_| -> Result<f64> {
+                    let s = Instant::now();
+                    model.step_in_region(pf, frame, obs)?;
+                    Ok(s.elapsed().as_secs_f64() * 1e3)
+                })
+                .collect::<Result<Vec<f64>>>()?;
+            Ok(median(&mut t))
+        })
+    };
     let (mut alls, mut ratios) = (Vec::new(), Vec::new());
     for _ in 0..SPEEDUP_ROUNDS {
-        let t1 = one_pool.install(|| -> Result<f64> {
-            let s = Instant::now();
-            model.step_in_region(&mut a, frame, &mut oa)?;
-            Ok(s.elapsed().as_secs_f64() * 1e3)
-        })?;
-        let t2 = all_pool.install(|| -> Result<f64> {
-            let s = Instant::now();
-            model.step_in_region(&mut b, frame, &mut ob)?;
-            Ok(s.elapsed().as_secs_f64() * 1e3)
-        })?;
+        let t1 = block(&one_pool, &mut a, &mut oa)?;
+        let t2 = block(&all_pool, &mut b, &mut ob)?;
         alls.push(t2);
         ratios.push(t1 / t2);
     }
@@ -149,13 +161,18 @@ pub fn run(json_out: bool) -> Result<()> {
     let threads = rayon::current_num_threads();
     figures.insert("threads".into(), json!(threads));
     let mut frame_bin = BinnedFrame::default();
-    let mut tb: Vec<f64> = (0..20)
-        .map(|_| {
-            let s = Instant::now();
-            frame_bin.update(&frame);
-            s.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
+    // Binning runs on the pool; one thread, as the figure was before it did.
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let mut tb: Vec<f64> = one_thread.install(|| {
+        (0..20)
+            .map(|_| {
+                let s = Instant::now();
+                frame_bin.update(&frame);
+                s.elapsed().as_secs_f64() * 1e3
+            })
+            .collect()
+    });
+    drop(one_thread);
     figures.insert("ms_bin_frame_640x480".into(), json!(median(&mut tb)));
     for (p, key) in [(100, "1e2"), (1000, "1e3"), (10_000, "1e4"), (100_000, "1e5")] {
         figures.insert(format!("ms_sir_step_{key}_1thread"), json!(sir_step_ms(p, 1, &frame, &model, &ball, false)?));
