@@ -34,6 +34,10 @@ def test_ray_example_equals_direct_calls(tmp_path):
     import pyarrow.parquet as pq
 
     by_path = lambda t: sorted(t, key=lambda r: r["path"])  # noqa: E731
+    import pyarrow as pa
+
+    # The maps are stored as float32, as the engine makes them.
+    assert pq.read_schema(next((tmp_path / "worker").glob("*.parquet"))).field("saliency").type == pa.list_(pa.float32())
     table = by_path(pq.read_table(tmp_path / "worker").to_pylist())
     assert table == by_path(pq.read_table(tmp_path / "reader").to_pylist())
     paths = sorted(stimuli.iterdir())
