@@ -87,11 +87,13 @@ def main() -> None:
         # without its start, which costs seconds whatever the corpus.
         t, t3 = seconds([paths, paths * 3], stimuli, cores, args.decode, cores, args.runs)
         figures[f"images_per_s_{cores}_cores"] = n / t
-        figures[f"steady_images_per_s_{cores}_cores"] = 2 * n / (t3 - t) if t3 > t else float("nan")
-        figures[f"job_start_s_{cores}_cores"] = t - n * (t3 - t) / (2 * n)
+        # None (JSON null) when the longer corpus did not take longer: too short to tell.
+        figures[f"steady_images_per_s_{cores}_cores"] = 2 * n / (t3 - t) if t3 > t else None
+        figures[f"job_start_s_{cores}_cores"] = t - (t3 - t) / 2 if t3 > t else None
     figures["speedup_2_workers"] = figures["images_per_s_2_workers"] / figures["images_per_s_1_workers"]
     figures["speedup_2_cores"] = figures["images_per_s_2_cores"] / figures["images_per_s_1_cores"]
-    figures["speedup_2_cores_steady"] = figures["steady_images_per_s_2_cores"] / figures["steady_images_per_s_1_cores"]
+    steady = figures["steady_images_per_s_1_cores"], figures["steady_images_per_s_2_cores"]
+    figures["speedup_2_cores_steady"] = steady[1] / steady[0] if None not in steady else None
     print(json.dumps(figures) if args.json else figures)
 
 
