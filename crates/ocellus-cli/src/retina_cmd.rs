@@ -116,9 +116,11 @@ struct LearnArgs {
     #[arg(long, default_value_t = ocellus_retina::experiment::DEFAULT_BLUR_PX, value_parser = ranges::within(0.0f64, 50.0))]
     blur: f64,
     /// Factor on the largest actions (shifts of half the disc radius, rotations of 30
-    /// degrees, dilations by e^0.3). Range: 0.05..=5.
-    #[arg(long, default_value_t = 1.0, value_parser = ranges::within(0.05f64, 5.0))]
-    action_scale: f64,
+    /// degrees, dilations by e^0.3) [default: 5 for experiment 1 with cells (rotations up to
+    /// 150 degrees, dilations up to e^1.5, shifts up to 2.5 radii), 1 otherwise]. Range:
+    /// 0.05..=5.
+    #[arg(long, value_parser = ranges::within(0.05f64, 5.0))]
+    action_scale: Option<f64>,
     /// Experiment 2: weight of the motor fields' smoothness (the mean squared difference of
     /// neighbouring motor cells) in the cost. Range: 0..=100.
     #[arg(long, default_value_t = 0.0, value_parser = ranges::within(0.0f64, 100.0))]
@@ -197,13 +199,18 @@ fn learn(a: LearnArgs) -> Result<()> {
     cfg.seed = a.seed;
     cfg.simplicity = a.simplicity;
     cfg.blur_px = a.blur;
-    cfg.action_scale = a.action_scale;
     cfg.motor_smoothness = a.motor_smoothness;
     match (a.motor_space, cfg.experiment) {
         (Some(MotorSpaceArg::Cells), 1) => cfg.motor_space = MotorSpace::Cells,
-        (Some(MotorSpaceArg::Values), 1) => cfg.motor_space = MotorSpace::Values,
+        (Some(MotorSpaceArg::Values), 1) => {
+            cfg.motor_space = MotorSpace::Values;
+            cfg.action_scale = 1.0;
+        }
         (Some(_), _) => bail!("--motor-space is for experiment 1 (experiment 2 learns its motor fields)"),
         (None, _) => {}
+    }
+    if let Some(k) = a.action_scale {
+        cfg.action_scale = k;
     }
     cfg.validate()?;
     let src = sources(a.images.as_deref())?;
@@ -292,6 +299,9 @@ fn learn(a: LearnArgs) -> Result<()> {
         None
     };
     let layout = measure(&su.disc, &main.params.s, cfg.fields)?;
+    let density = |l: &ocellus_retina::layout::Layout| {
+        l.density_ratio.map(|d| format!("{d:.2}")).unwrap_or_else(|| "none outside".into())
+    };
     outln!(
         "held-out mse per pixel: learned {:.6}, identity {:.6}{}",
         mse_learned,
@@ -299,7 +309,7 @@ fn learn(a: LearnArgs) -> Result<()> {
         baseline.as_ref().map(|b| format!(", random fixed S {:.6}", b.0)).unwrap_or_default()
     );
     outln!(
-        "layout: {} live fields ({} dead), fovea index {:.3} (start {:.3}), over the {} interior fields {:.3} (start {:.3}), slope {:.2} px^2/px, areas centre {:.1} / periphery {:.1} px^2, density ratio {}",
+        "layout: {} live fields ({} dead), fovea index {:.3} (start {:.3}), over the {} interior fields {:.3} (start {:.3}), slope {:.2} px^2/px, areas centre {:.1} / periphery {:.1} px^2, density ratio {} (start {})",
         layout.fields.len(),
         layout.dead,
         layout.fovea_index,
@@ -310,7 +320,8 @@ fn learn(a: LearnArgs) -> Result<()> {
         layout.slope_px2_per_px,
         layout.mean_area_centre_px,
         layout.mean_area_periphery_px,
-        layout.density_ratio.map(|d| format!("{d:.2}")).unwrap_or_else(|| "none outside".into())
+        density(&layout),
+        density(&layout0)
     );
     write_outputs(&a.out, &su, &runs, best, &layout)?;
     let figures = json!({
@@ -349,6 +360,7 @@ fn learn(a: LearnArgs) -> Result<()> {
         "fovea_index_start": layout0.fovea_index,
         "fovea_index_interior": layout.fovea_index_interior,
         "fovea_index_interior_start": layout0.fovea_index_interior,
+        "density_ratio_start": layout0.density_ratio,
         "layout": layout,
     });
     let f = a.out.join("retina.json");

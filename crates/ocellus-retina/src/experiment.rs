@@ -51,7 +51,8 @@ pub struct ExperimentConfig {
     /// pixels; 0 for none.
     pub blur_px: f64,
     /// Factor on the default largest actions of [`ActionRanges::for_radius`] (shift r / 2,
-    /// rotation 30 degrees, log-scale 0.3).
+    /// rotation 30 degrees, log-scale 0.3): [`SENSOR_DESIGN_ACTION_SCALE`] for experiment 1
+    /// with cells, 1 otherwise.
     pub action_scale: f64,
     /// Experiment 2: weight of the motor fields' smoothness over the motor grid (see
     /// [`crate::model::Objective::smoothness`]); 0 for none.
@@ -104,7 +105,7 @@ impl ExperimentConfig {
             simplicity: DEFAULT_SIMPLICITY,
             seed: 1,
             blur_px: DEFAULT_BLUR_PX,
-            action_scale: 1.0,
+            action_scale: if actions == ActionKinds::All { 1.0 } else { SENSOR_DESIGN_ACTION_SCALE },
             motor_smoothness: 0.0,
             motor_space: if actions == ActionKinds::All { MotorSpace::Values } else { MotorSpace::Cells },
         }
@@ -120,6 +121,7 @@ impl ExperimentConfig {
             grid_cells: 15,
             triplets: 22_500,
             heldout: 2_500,
+            action_scale: 1.0,
             ..Self::sensor_design(actions)
         }
     }
@@ -199,6 +201,20 @@ impl ExperimentConfig {
 
 /// Default weight lambda of the simplicity term.
 pub const DEFAULT_SIMPLICITY: f64 = 1e-3;
+
+/// Experiment 1's factor on the largest actions of [`ActionRanges::for_radius`] with its
+/// motor fields as cells: rotations up to 150 degrees (nearly the whole circle), dilations up
+/// to e^1.5, shifts up to 2.5 disc radii, so that each of the 10 x 6 cells spans 30 degrees
+/// and 0.5 in log-scale (or half a radius across and 0.83 down). A cell's predictor serves
+/// its whole range: under rotation and dilation the content of a pixel at eccentricity e
+/// lands anywhere along an arc of about 0.5 e, which at the rim (15 px) exceeds the width of
+/// a field of the uniform tiling (about 9 px across), so fine fields pay only near the centre.
+/// Under translation the spread is the same at every eccentricity. Seed 1, PGD, interior
+/// fields' fovea index and density ratio centre / periphery at factors 1 / 2 / 3 / 5 with
+/// rotation + dilation: 0.23 / 0.31 / 0.43 / 0.73 and 1.0 / 1.0 / 1.36 / 1.65; with
+/// translation at 3 / 5: -0.05 / 0.07 and 1.00 / 1.11 (`ocellus retina learn --experiment 1
+/// --action-scale K`). With exact action values (and all four actions) the factor is 1.
+pub const SENSOR_DESIGN_ACTION_SCALE: f64 = 5.0;
 
 /// Default blur of the sources, pixels (none).
 pub const DEFAULT_BLUR_PX: f64 = 0.0;
@@ -378,6 +394,10 @@ mod tests {
         let two = ExperimentConfig::co_development(ActionKinds::RotationDilation);
         assert_eq!(two.shape().sizes(), [7_696, 3_600, 4_096]);
         assert_eq!(two.variables(), 15_392);
+        // Wide ranges where the motor fields are cells; the first build's where not.
+        assert_eq!(one.action_scale, SENSOR_DESIGN_ACTION_SCALE);
+        assert_eq!(two.action_scale, 1.0);
+        assert_eq!(ExperimentConfig::sensor_design(ActionKinds::All).action_scale, 1.0);
         assert!(ExperimentConfig { actions: ActionKinds::All, ..two }.validate().is_err());
         // All four actions have no 2D motor space to tile.
         assert_eq!(ExperimentConfig::sensor_design(ActionKinds::All).motor_space, MotorSpace::Values);

@@ -20,7 +20,11 @@ fn sources() -> Vec<ocellus_image::Plane<f32>> {
 
 /// (fovea index at the start, after learning, held-out mse learned, identity).
 fn run(actions: ActionKinds, motor_space: MotorSpace, seed: u64) -> (f64, f64, f64, f64) {
-    let cfg = ExperimentConfig { seed, motor_space, ..ExperimentConfig::sensor_design_small(actions) };
+    let mut cfg = ExperimentConfig { seed, motor_space, ..ExperimentConfig::sensor_design_small(actions) };
+    if motor_space == MotorSpace::Values {
+        // Exact values keep the ranges of the first build.
+        cfg.action_scale = 1.0;
+    }
     let su = setup::<f32>(&cfg, &sources()).unwrap();
     let mut p = start(&su, Init::Blobs, seed).unwrap();
     let before = measure(&su.disc, &p.s, cfg.fields).unwrap().fovea_index;
@@ -34,9 +38,10 @@ fn run(actions: ActionKinds, motor_space: MotorSpace, seed: u64) -> (f64, f64, f
 
 #[test]
 fn rotation_and_dilation_grow_a_fovea_and_translation_does_not() {
-    // Motor fields as cells: over seeds 1-6 the index was +0.01 to +0.51 with rotations and
-    // dilations, -0.46 to +0.27 with translations, higher with rotations and dilations on
-    // every seed (by 0.22 to 0.65); seeds 1-3 here.
+    // Motor fields as cells, at experiment 1's default action ranges (factor 5): over seeds
+    // 1-6 the index was +0.30 to +0.65 with rotations and dilations, -0.76 to -0.40 with
+    // translations (the rim cuts its fields small); the held-out error against the
+    // identity's 0.41-0.53 and 0.61-0.71. Seeds 1-3 here.
     for seed in [1, 2, 3] {
         let (b_rd, rd, held_rd, id_rd) = run(ActionKinds::RotationDilation, MotorSpace::Cells, seed);
         let (b_tr, tr, held_tr, id_tr) = run(ActionKinds::Translation, MotorSpace::Cells, seed);
@@ -45,7 +50,7 @@ fn rotation_and_dilation_grow_a_fovea_and_translation_does_not() {
         assert!(rd > 0.15, "seed {seed}: rotation + dilation fovea index {rd} (start {b_rd})");
         assert!(rd - tr > 0.15, "seed {seed}: {rd} against {tr}");
         assert!(
-            held_rd < 0.8 * id_rd && held_tr < 0.7 * id_tr,
+            held_rd < 0.6 * id_rd && held_tr < 0.75 * id_tr,
             "seed {seed}: {held_rd} / {id_rd}, {held_tr} / {id_tr}"
         );
     }
