@@ -51,8 +51,10 @@ pub struct ExperimentConfig {
     /// pixels; 0 for none.
     pub blur_px: f64,
     /// Factor on the default largest actions of [`ActionRanges::for_radius`] (shift r / 2,
-    /// rotation 30 degrees, log-scale 0.3): [`SENSOR_DESIGN_ACTION_SCALE`] for experiment 1
-    /// with cells, 1 otherwise.
+    /// rotation 30 degrees, log-scale 0.3): [`ExperimentConfig::sensor_design`] sets
+    /// [`SENSOR_DESIGN_ACTION_SCALE`] (1 for all four actions), experiment 2 sets 1. A config
+    /// switched to [`MotorSpace::Values`] keeps what it had; the CLI then sets 1, the ranges the
+    /// values were first built with.
     pub action_scale: f64,
     /// Experiment 2: weight of the motor fields' smoothness over the motor grid (see
     /// [`crate::model::Objective::smoothness`]); 0 for none.
