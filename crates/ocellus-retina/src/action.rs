@@ -58,6 +58,25 @@ impl Action {
         }
     }
 
+    /// The share of the disc of `radius` pixels after the action that shows what the disc
+    /// showed before it, in [0, 1]: what i1 holds of i0, the part of it that any sensor could
+    /// predict. A shift by d keeps the lens where two discs d apart overlap, a share
+    /// `(2 / pi) (acos x - x sqrt(1 - x^2))` with x = d / 2r (nothing beyond d = 2r). A
+    /// rotation about the gaze point keeps everything, a zoom in (s > 0) too, and a zoom out
+    /// keeps the central disc of radius r e^s, a share e^2s.
+    pub fn kept_share(&self, radius: f64) -> f64 {
+        match *self {
+            Action::Shift { dx, dy } => {
+                let x = (dx.hypot(dy) / (2.0 * radius)).min(1.0);
+                if x.is_nan() {
+                    return 0.0;
+                }
+                (2.0 / std::f64::consts::PI) * (x.acos() - x * (1.0 - x * x).max(0.0).sqrt())
+            }
+            Action::RotateDilate { s, .. } => (2.0 * s).exp().min(1.0),
+        }
+    }
+
     /// How far any pixel within `radius` of the gaze point may sample from it, pixels.
     pub fn reach(&self, radius: f64) -> f64 {
         match *self {
@@ -217,6 +236,21 @@ impl ActionRanges {
         self.uniform(kinds, [(ix as f64 + u[0]) / nx as f64, (iy as f64 + u[1]) / ny as f64])
     }
 
+    /// The mean of [`Action::kept_share`] over the actions of a 2D kind drawn uniformly from
+    /// the motor space (a 200 x 200 midpoint grid): how much of what the eye sees after an
+    /// action it saw before, on average.
+    pub fn mean_kept_share(&self, kinds: ActionKinds, radius: f64) -> Result<f64> {
+        const N: usize = 200;
+        let mut sum = 0.0;
+        for j in 0..N {
+            for i in 0..N {
+                let u = [(i as f64 + 0.5) / N as f64, (j as f64 + 0.5) / N as f64];
+                sum += self.uniform(kinds, u)?.kept_share(radius);
+            }
+        }
+        Ok(sum / (N * N) as f64)
+    }
+
     /// A uniform random action of a 2D kind, from two uniforms in [0, 1).
     pub fn uniform(&self, kinds: ActionKinds, u: [f64; 2]) -> Result<Action> {
         let e = self.extent(kinds)?;
@@ -325,6 +359,53 @@ impl MotorCode {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_kept_share_is_what_a_pixel_count_finds() {
+        // Independent reference: the share of points on a fine grid over the disc whose source
+        // after the action (`map`) lies inside the disc before it.
+        let r = 30.0;
+        let brute = |a: &Action| {
+            let (mut kept, mut all) = (0usize, 0usize);
+            let step = r / 150.0;
+            for j in -150..=150 {
+                for i in -150..=150 {
+                    let p = [i as f64 * step, j as f64 * step];
+                    if p[0].hypot(p[1]) <= r {
+                        all += 1;
+                        let q = a.map(p);
+                        kept += usize::from(q[0].hypot(q[1]) <= r);
+                    }
+                }
+            }
+            kept as f64 / all as f64
+        };
+        for a in [
+            Action::Shift { dx: 0.0, dy: 0.0 },
+            Action::Shift { dx: 15.0, dy: 0.0 },
+            Action::Shift { dx: -21.0, dy: 21.0 },
+            Action::Shift { dx: 0.0, dy: 59.0 },
+            Action::Shift { dx: 70.0, dy: 10.0 },
+            Action::RotateDilate { theta: 2.5, s: 0.0 },
+            Action::RotateDilate { theta: -1.0, s: 0.7 },
+            Action::RotateDilate { theta: 0.3, s: -0.5 },
+            Action::RotateDilate { theta: 0.0, s: -1.5 },
+        ] {
+            let (got, want) = (a.kept_share(r), brute(&a));
+            assert!((got - want).abs() < 0.01, "{a:?}: {got} vs {want}");
+        }
+        // Both action sets at experiment 1's default ranges keep about as much on average.
+        let d = ActionRanges::for_radius(r);
+        let scaled = |k: f64| ActionRanges {
+            shift_px: k * d.shift_px,
+            rotation_rad: k * d.rotation_rad,
+            log_scale: k * d.log_scale,
+        };
+        let rd = scaled(5.0).mean_kept_share(ActionKinds::RotationDilation, r).unwrap();
+        // Half the zooms keep all, the others e^2s: (1 + (1 - e^-3) / 3) / 2.
+        assert!((rd - (1.0 + (1.0 - (-3f64).exp()) / 3.0) / 2.0).abs() < 1e-3, "{rd}");
+        assert!(scaled(5.0).mean_kept_share(ActionKinds::All, r).is_err());
+    }
 
     #[test]
     fn actions_map_points_as_defined() {

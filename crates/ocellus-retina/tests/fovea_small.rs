@@ -38,10 +38,11 @@ fn run(actions: ActionKinds, motor_space: MotorSpace, seed: u64) -> (f64, f64, f
 
 #[test]
 fn rotation_and_dilation_grow_a_fovea_and_translation_does_not() {
-    // Motor fields as cells, at experiment 1's default action ranges (factor 5): over seeds
-    // 1-6 the index was +0.30 to +0.65 with rotations and dilations, -0.76 to -0.40 with
-    // translations (the rim cuts its fields small); the held-out error against the
-    // identity's 0.41-0.53 and 0.61-0.71. Seeds 1-3 here.
+    // Motor fields as cells, at experiment 1's default action ranges (factor 5 for rotations
+    // and dilations, 1.5 for shifts): over seeds 1-6 the index was +0.30 to +0.65 with
+    // rotations and dilations, -0.41 to +0.06 with translations (-0.76 to -0.40 with shifts
+    // at factor 5, where the rim cut the fields small); the held-out error against the
+    // identity's 0.41-0.53 and 0.44-0.52. Seeds 1-3 here.
     for seed in [1, 2, 3] {
         let (b_rd, rd, held_rd, id_rd) = run(ActionKinds::RotationDilation, MotorSpace::Cells, seed);
         let (b_tr, tr, held_tr, id_tr) = run(ActionKinds::Translation, MotorSpace::Cells, seed);
@@ -50,7 +51,7 @@ fn rotation_and_dilation_grow_a_fovea_and_translation_does_not() {
         assert!(rd > 0.15, "seed {seed}: rotation + dilation fovea index {rd} (start {b_rd})");
         assert!(rd - tr > 0.15, "seed {seed}: {rd} against {tr}");
         assert!(
-            held_rd < 0.6 * id_rd && held_tr < 0.75 * id_tr,
+            held_rd < 0.6 * id_rd && held_tr < 0.6 * id_tr,
             "seed {seed}: {held_rd} / {id_rd}, {held_tr} / {id_tr}"
         );
     }
