@@ -234,6 +234,11 @@ fn learn(a: LearnArgs) -> Result<()> {
         src.len(),
         su.disc.radius()
     );
+    // How much of the view an action keeps on average (2D motor spaces only).
+    let kept = su.ranges.mean_kept_share(cfg.actions, su.disc.radius()).ok();
+    if let Some(k) = kept {
+        outln!("an action keeps {:.0} % of the view in view on average", 100.0 * k);
+    }
     create_dir(&a.out)?;
     let ckpt = a.out.join("checkpoint");
     create_dir(&ckpt)?;
@@ -362,6 +367,7 @@ fn learn(a: LearnArgs) -> Result<()> {
         "fovea_index_interior": layout.fovea_index_interior,
         "fovea_index_interior_start": layout0.fovea_index_interior,
         "density_ratio_start": layout0.density_ratio,
+        "kept_share_mean": kept,
         "layout": layout,
     });
     let f = a.out.join("retina.json");
