@@ -57,6 +57,12 @@ pub struct OdometryArgs {
     /// change followed whole). Range: 0 or 1..=1000000.
     #[arg(long, default_value_t = 32.0, value_parser = ranges::within(0.0f64, 1e6))]
     height_noise_frames: f64,
+    /// Robust mode: the brightness ratio between frames as a smooth field over the image,
+    /// fitted through the windows' own gains (against vignetting: a floor point moving toward a
+    /// darker corner changes brightness, which one gain for the whole frame reads as flow);
+    /// `--gain-field false` keeps one global gain.
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    gain_field: bool,
     /// Frame rate, Hz (timestamps of the trajectory). Range: above 0, at most 1000000.
     #[arg(long, default_value_t = 200.0, value_parser = ranges::above(0.0f64, 1e6))]
     rate_hz: f64,
@@ -134,6 +140,7 @@ pub fn run(a: OdometryArgs) -> Result<()> {
     };
     cfg.robust.height_pull = a.height_pull;
     cfg.robust.height_noise_frames = a.height_noise_frames;
+    cfg.robust.gain_field = a.gain_field;
     let mut vo = VisualOdometry::new(cfg)?;
     let readings: Option<Vec<EncoderReading>> = match &a.encoders {
         Some(p) => {

@@ -106,12 +106,13 @@ const LANES: usize = 8;
 
 ocellus_image::dispatch_kernel!(
     /// The Lucas-Kanade normal equations of the `b` x `b` square with top-left pixel (bx, by)
-    /// (integers) of `prev`: `[sum gx^2, sum gx gy, sum gy^2, sum gx e, sum gy e, sum e^2]` with
-    /// the gradients g and differences e of `cur` (times `gain`) warped by (dx, dy) against
-    /// `prev`. The warp has one fractional part for the whole square, so `cur` is resampled once
-    /// into a patch with a one-pixel border (`patch`, reused between calls) and the gradients
-    /// are central differences there.
-    pub(crate) fn lk_sums => lk_sums_generic(
+    /// (integers) of `prev`: `[sum gx^2, sum gx gy, sum gy^2, sum gx e, sum gy e, sum e^2]`
+    /// with the values c, gradients g and differences e = c - prev of `cur` (times `gain`)
+    /// warped by (dx, dy); the last four entries are 0 (see [`lk_sums_gain`]). The warp has
+    /// one fractional part for the whole square, so `cur` is resampled once into a patch with
+    /// a one-pixel border (`patch`, reused between calls) and the gradients are central
+    /// differences there.
+    pub(crate) fn lk_sums => lk_sums_flow(
         prev: &Plane<f32>,
         cur: &Plane<f32>,
         bx: usize,
@@ -121,12 +122,28 @@ ocellus_image::dispatch_kernel!(
         dy: f64,
         gain: f64,
         patch: &mut Vec<f32>,
-    ) -> [f64; 6]
+    ) -> [f64; 10]
+);
+
+ocellus_image::dispatch_kernel!(
+    /// [`lk_sums`] with the window's own gain as a third unknown: also `[sum c gx, sum c gy,
+    /// sum c^2, sum c e]`.
+    pub(crate) fn lk_sums_gain => lk_sums_flow_gain(
+        prev: &Plane<f32>,
+        cur: &Plane<f32>,
+        bx: usize,
+        by: usize,
+        b: usize,
+        dx: f64,
+        dy: f64,
+        gain: f64,
+        patch: &mut Vec<f32>,
+    ) -> [f64; 10]
 );
 
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn lk_sums_generic<M: Madd>(
+fn lk_sums_flow<M: Madd>(
     prev: &Plane<f32>,
     cur: &Plane<f32>,
     bx: usize,
@@ -136,7 +153,47 @@ fn lk_sums_generic<M: Madd>(
     dy: f64,
     gain: f64,
     patch: &mut Vec<f32>,
-) -> [f64; 6] {
+) -> [f64; 10] {
+    lk_sums_generic::<M, false>(prev, cur, bx, by, b, dx, dy, gain, patch)
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn lk_sums_flow_gain<M: Madd>(
+    prev: &Plane<f32>,
+    cur: &Plane<f32>,
+    bx: usize,
+    by: usize,
+    b: usize,
+    dx: f64,
+    dy: f64,
+    gain: f64,
+    patch: &mut Vec<f32>,
+) -> [f64; 10] {
+    lk_sums_generic::<M, true>(prev, cur, bx, by, b, dx, dy, gain, patch)
+}
+
+/// `acc[l] += a[l] b[l]` over the lanes.
+#[inline(always)]
+fn madd_lanes<M: Madd>(acc: &mut [f32; LANES], a: &[f32; LANES], b: &[f32; LANES]) {
+    for l in 0..LANES {
+        acc[l] = M::madd(a[l], b[l], acc[l]);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn lk_sums_generic<M: Madd, const GAIN: bool>(
+    prev: &Plane<f32>,
+    cur: &Plane<f32>,
+    bx: usize,
+    by: usize,
+    b: usize,
+    dx: f64,
+    dy: f64,
+    gain: f64,
+    patch: &mut Vec<f32>,
+) -> [f64; 10] {
     let n = b + 2;
     let (sx, sy) = (bx as f64 - 1.0 + dx, by as f64 - 1.0 + dy);
     let (fx, fy) = (floor(sx), floor(sy));
@@ -167,7 +224,7 @@ fn lk_sums_generic<M: Madd>(
         }
     }
     // acc[k][l]: lane l of sum k; summed over the lanes at the end.
-    let mut acc = [[0.0f32; LANES]; 6];
+    let mut acc = [[0.0f32; LANES]; 10];
     let x0 = bx.min(prev.width().saturating_sub(b));
     let full = b / LANES * LANES;
     let lanes = |v: &[f32], at: usize| -> Option<[f32; LANES]> { v.get(at..at + LANES)?.try_into().ok() };
@@ -191,17 +248,28 @@ fn lk_sums_generic<M: Madd>(
             let gx: [f32; LANES] = std::array::from_fn(|l| 0.5 * (right[l] - left[l]));
             let gy: [f32; LANES] = std::array::from_fn(|l| 0.5 * (d[l] - u[l]));
             let e: [f32; LANES] = std::array::from_fn(|l| centre[l] - p[l]);
-            for (k, (a, b)) in
-                [(&gx, &gx), (&gx, &gy), (&gy, &gy), (&gx, &e), (&gy, &e), (&e, &e)].into_iter().enumerate()
-            {
-                for l in 0..LANES {
-                    acc[k][l] = M::madd(a[l], b[l], acc[k][l]);
-                }
+            // Written out, not as a loop over pairs: the compiler did not unroll a loop over
+            // ten pairs, and the robust step took 2.4x as long.
+            madd_lanes::<M>(&mut acc[0], &gx, &gx);
+            madd_lanes::<M>(&mut acc[1], &gx, &gy);
+            madd_lanes::<M>(&mut acc[2], &gy, &gy);
+            madd_lanes::<M>(&mut acc[3], &gx, &e);
+            madd_lanes::<M>(&mut acc[4], &gy, &e);
+            madd_lanes::<M>(&mut acc[5], &e, &e);
+            if GAIN {
+                madd_lanes::<M>(&mut acc[6], &centre, &gx);
+                madd_lanes::<M>(&mut acc[7], &centre, &gy);
+                madd_lanes::<M>(&mut acc[8], &centre, &centre);
+                madd_lanes::<M>(&mut acc[9], &centre, &e);
             }
         }
         for i in full + 1..=b {
-            let (gx, gy, e) = (0.5 * (mid[i + 1] - mid[i - 1]), 0.5 * (down[i] - up[i]), mid[i] - prow[i - 1]);
-            for (k, v) in [gx * gx, gx * gy, gy * gy, gx * e, gy * e, e * e].into_iter().enumerate() {
+            let c = mid[i];
+            let (gx, gy, e) = (0.5 * (mid[i + 1] - mid[i - 1]), 0.5 * (down[i] - up[i]), c - prow[i - 1]);
+            let g = if GAIN { [c * gx, c * gy, c * c, c * e] } else { [0.0; 4] };
+            for (k, v) in
+                [gx * gx, gx * gy, gy * gy, gx * e, gy * e, e * e, g[0], g[1], g[2], g[3]].into_iter().enumerate()
+            {
                 acc[k][0] += v;
             }
         }
@@ -225,21 +293,28 @@ mod tests {
         // Every build of the kernel; supports with and without a part narrower than the lanes.
         let cases = [(20, 15, 8, 0.4, -0.3), (10, 10, 16, 0.25, 0.0), (0, 0, 8, -1.5, 0.7), (30, 20, 12, 0.6, 0.45)];
         for (backend, (bx, by, b, dx, dy)) in Backend::available().into_iter().flat_map(|k| cases.map(|c| (k, c))) {
-            let got = lk_sums(backend, &img, &cur, bx, by, b, dx, dy, 1.1, &mut patch);
-            let mut want = [0.0f64; 6];
+            let got = lk_sums_gain(backend, &img, &cur, bx, by, b, dx, dy, 1.1, &mut patch);
+            let flow_only = lk_sums(backend, &img, &cur, bx, by, b, dx, dy, 1.1, &mut patch);
+            assert_eq!(flow_only[..6], got[..6]);
+            assert_eq!(flow_only[6..], [0.0; 4]);
+            let mut want = [0.0f64; 10];
             for j in 0..b {
                 for i in 0..b {
                     let (x, y) = ((bx + i) as f64 + dx, (by + j) as f64 + dy);
                     let c = |x: f64, y: f64| 1.1 * sample_bilinear(&cur, x as f32, y as f32) as f64;
                     let gx = 0.5 * (c(x + 1.0, y) - c(x - 1.0, y));
                     let gy = 0.5 * (c(x, y + 1.0) - c(x, y - 1.0));
-                    let e = c(x, y) - img.get(bx + i, by + j) as f64;
-                    for (k, v) in [gx * gx, gx * gy, gy * gy, gx * e, gy * e, e * e].into_iter().enumerate() {
+                    let v = c(x, y);
+                    let e = v - img.get(bx + i, by + j) as f64;
+                    for (k, v) in [gx * gx, gx * gy, gy * gy, gx * e, gy * e, e * e, v * gx, v * gy, v * v, v * e]
+                        .into_iter()
+                        .enumerate()
+                    {
                         want[k] += v;
                     }
                 }
             }
-            for k in 0..6 {
+            for k in 0..10 {
                 assert!(
                     (got[k] - want[k]).abs() <= 1e-3 * want[k].abs().max(1.0),
                     "{backend:?} {bx} {by} {b}: {got:?} vs {want:?}"
