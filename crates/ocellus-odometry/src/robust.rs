@@ -338,7 +338,7 @@ struct LkFrames<'a> {
 struct Refined {
     /// Flow, pixels.
     flow: (f64, f64),
-    /// The structure tensor (with the gain free: its Schur complement).
+    /// The structure tensor (the gain fixed; not filled with the gain free).
     tensor: [[f64; 2]; 2],
     /// What the last linearized step leaves of the squared differences.
     residual: f64,
@@ -380,12 +380,10 @@ impl LkFrames<'_> {
                 if !(g.is_finite() && g > 0.5 * gain && g < 2.0 * gain) {
                     return None;
                 }
-                // The flow's information once the gain is free, and the gain's once the flow is.
-                let t = [[a11 - c1 * c1 / c3, a12 - c1 * c2 / c3], [a12 - c1 * c2 / c3, a22 - c2 * c2 / c3]];
+                // The gain's information once the flow is free (only the gain is used from
+                // this pass).
                 let det = a11 * a22 - a12 * a12;
-                let cinv = (a22 * c1 * c1 - 2.0 * a12 * c1 * c2 + a11 * c2 * c2) / det;
-                r.tensor = t;
-                r.gain_info = c3 - cinv;
+                r.gain_info = c3 - (a22 * c1 * c1 - 2.0 * a12 * c1 * c2 + a11 * c2 * c2) / det;
             } else {
                 r.tensor = [[a11, a12], [a12, a22]];
                 let det = a11 * a22 - a12 * a12;
