@@ -188,6 +188,11 @@ const CASES: &[Case] = &[
     c("retina learn --experiment 1 --motor-space grid --out {O}", Usage(&["--motor-space"])),
     c("retina learn --experiment 1 --small --resume --out {O}", Error(&["no checkpoint"])),
     c("retina learn --experiment 1 --small --images {D}/missing --out {O}", Error(&["missing"])),
+    c("retina summary", Usage(&["runs"])),
+    c("retina summary {D}/missing", Error(&["missing", "retina.json"])),
+    c("retina summary {D}/empty_dir", Error(&["empty_dir", "retina.json"])),
+    c("retina summary {D}/retina_bad", Error(&["retina_bad", "not json"])),
+    c("retina summary {D}/retina_old", Error(&["retina_old", "action_scale"])),
     c("generate ball --frames 0 --out {O}", Usage(&["--frames", "range"])),
     c("generate ball --frames 10 --occluded-frames 8 --out {O}", Error(&["occlusion", "do not fit"])),
     c("generate ball --noise NaN --out {O}", Usage(&["--noise", "range"])),
@@ -319,7 +324,18 @@ fn fixtures(d: &Path) {
     image::imageops::resize(&chelsea, 160, 120, image::imageops::FilterType::Triangle)
         .save(d.join("small.png"))
         .unwrap();
-    for sub in ["a", "b", "frames", "empty_dir", "stim", "fix", "points_extra", "mp4_is_dir/overlays.mp4"] {
+    for sub in [
+        "a",
+        "b",
+        "frames",
+        "empty_dir",
+        "stim",
+        "fix",
+        "points_extra",
+        "mp4_is_dir/overlays.mp4",
+        "retina_bad",
+        "retina_old",
+    ] {
         std::fs::create_dir_all(d.join(sub)).unwrap();
     }
     img.save(d.join("a/x.png")).unwrap();
@@ -337,6 +353,8 @@ fn fixtures(d: &Path) {
     w("corrupt.png", &corrupt);
     w("text.png", b"this is not an image\n");
     w("notes.txt", b"not an image either\n");
+    w("retina_bad/retina.json", b"{ \"experiment\": 1,");
+    w("retina_old/retina.json", b"{ \"experiment\": 1, \"config\": { \"actions\": \"translation\" } }");
     let jpg = std::fs::read(ocellus_testdata::data_file("rocket.jpg")).unwrap();
     w("trunc.jpg", &jpg[..jpg.len() / 2]);
     let mut huge = b"P5\n20000 20000\n255\n".to_vec();

@@ -38,6 +38,23 @@ fn learn_writes_the_model_the_pictures_and_the_figures_and_resumes() {
     let j = figures(&out);
     assert_eq!(j["runs"][0]["iterations"], 60);
     assert!(j["runs"][0]["cost"].as_f64().unwrap() < cost30);
+    // The same run twice pools to its own index, over twice its fields, with an interval
+    // that narrows as 1 / sqrt(n - 3) in Fisher's z.
+    let o = ocellus().args(["retina", "summary", "--json"]).arg(&out).arg(&out).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let sum: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (r, n) = (j["layout"]["fovea_index"].as_f64().unwrap(), j["layout"]["fields"].as_array().unwrap().len());
+    let pooled = &sum["pooled"][0]["fovea_index"];
+    assert_eq!(sum["pooled"].as_array().unwrap().len(), 1);
+    assert!((pooled["r"].as_f64().unwrap() - r).abs() < 1e-9);
+    assert_eq!(pooled["pairs"].as_u64().unwrap() as usize, 2 * n);
+    let half = |ci: &serde_json::Value| {
+        let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+        (hi.atanh() - lo.atanh()) / 2.0
+    };
+    let one = half(&j["layout"]["fovea_index_ci95"]);
+    assert!((one - 1.959964 / ((n - 3) as f64).sqrt()).abs() < 1e-5, "{one}");
+    assert!((half(&pooled["ci95"]) - one / 2f64.sqrt()).abs() < 1e-5);
     // Another experiment's checkpoint is refused.
     let o = ocellus()
         .args(["retina", "learn", "--experiment", "1", "--small", "--actions", "translation", "--resume", "--out"])

@@ -38,6 +38,13 @@ pub struct Layout {
     pub fovea_index_interior: f64,
     /// Interior fields counted in [`fovea_index_interior`](Self::fovea_index_interior).
     pub interior_fields: usize,
+    /// 95 % confidence interval of [`fovea_index`](Self::fovea_index) ([`correlation_ci95`]):
+    /// an index is told apart from 0 only when the interval excludes 0.
+    #[serde(default = "full_interval")]
+    pub fovea_index_ci95: [f64; 2],
+    /// 95 % confidence interval of [`fovea_index_interior`](Self::fovea_index_interior).
+    #[serde(default = "full_interval")]
+    pub fovea_index_interior_ci95: [f64; 2],
     /// Least-squares slope of area against eccentricity, px^2 per px.
     pub slope_px2_per_px: f64,
     /// Field centres per unit area inside half the disc radius over those outside it
@@ -95,11 +102,68 @@ pub fn measure<T: Real>(disc: &Disc, s: &[T], fields: usize) -> Result<Layout> {
         fovea_index,
         fovea_index_interior,
         interior_fields: interior.len(),
+        fovea_index_ci95: correlation_ci95(fovea_index, out.len()),
+        fovea_index_interior_ci95: correlation_ci95(fovea_index_interior, interior.len()),
         slope_px2_per_px: slope,
         density_ratio,
         mean_area_centre_px: mean(&inner),
         mean_area_periphery_px: mean(&outer),
         fields: out,
+    })
+}
+
+/// What an interval says when nothing is known: the whole range of a correlation.
+fn full_interval() -> [f64; 2] {
+    [-1.0, 1.0]
+}
+
+/// Two-sided 95 % quantile of the standard normal.
+const Z95: f64 = 1.959_963_984_540_054;
+
+/// 95 % confidence interval of a Pearson correlation `r` over `n` pairs, by Fisher's z
+/// transformation: `atanh(r)` is close to normal with standard error `1 / sqrt(n - 3)` (Fisher
+/// 1921). With 48 fields an index within about +-0.28 of 0 is not told apart from 0.
+/// `[-1, 1]` for fewer than 4 pairs or a non-finite `r`.
+pub fn correlation_ci95(r: f64, n: usize) -> [f64; 2] {
+    pooled_correlation(&[(r, n)]).map(|p| p.ci95).unwrap_or_else(full_interval)
+}
+
+/// Correlations of several runs (e.g. seeds) pooled into one.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Pooled {
+    /// The pooled correlation.
+    pub r: f64,
+    /// Its 95 % confidence interval.
+    pub ci95: [f64; 2],
+    /// Runs pooled.
+    pub runs: usize,
+    /// Pairs (fields) over all runs.
+    pub pairs: usize,
+}
+
+/// Pools correlations `(r, n)` of independent runs: the mean of their Fisher z weighted by
+/// `n - 3` (the inverse of each z's variance), with the standard error `1 / sqrt(sum(n - 3))`
+/// (the fixed-effect estimate of Hedges & Olkin 1985, ch. 11). Runs with fewer than 4 pairs
+/// or a non-finite `r` are left out; `None` when none is left.
+pub fn pooled_correlation(runs: &[(f64, usize)]) -> Option<Pooled> {
+    // |r| = 1 has an infinite z; clamp just inside.
+    let lim = 1.0 - 1e-12;
+    let used: Vec<(f64, f64, usize)> = runs
+        .iter()
+        .filter(|(r, n)| r.is_finite() && *n >= 4)
+        .map(|&(r, n)| (r.clamp(-lim, lim).atanh(), (n - 3) as f64, n))
+        .collect();
+    let w: f64 = used.iter().map(|u| u.1).sum();
+    if used.is_empty() || w <= 0.0 {
+        return None;
+    }
+    let z = used.iter().map(|u| u.0 * u.1).sum::<f64>() / w;
+    let se = 1.0 / w.sqrt();
+    Some(Pooled {
+        r: z.tanh(),
+        ci95: [(z - Z95 * se).tanh(), (z + Z95 * se).tanh()],
+        runs: used.len(),
+        pairs: used.iter().map(|u| u.2).sum(),
     })
 }
 
@@ -170,6 +234,54 @@ mod tests {
         assert!(l.fovea_index.abs() < 0.3, "{}", l.fovea_index);
         assert!(l.fovea_index_interior.abs() < 0.3, "{}", l.fovea_index_interior);
         assert!(measure(&disc, &[0.0f64; 10], 2).is_err());
+    }
+
+    #[test]
+    fn the_interval_of_a_correlation_is_fishers() {
+        // r = 0.5, n = 28: z = atanh 0.5 = 0.549306, se = 0.2, z +- 1.96 se -> tanh.
+        let [lo, hi] = correlation_ci95(0.5, 28);
+        assert!((lo - 0.156_5).abs() < 1e-3 && (hi - 0.735_6).abs() < 1e-3, "{lo} {hi}");
+        assert_eq!(correlation_ci95(0.3, 3), [-1.0, 1.0]);
+        assert_eq!(correlation_ci95(f64::NAN, 30), [-1.0, 1.0]);
+        let [lo, hi] = correlation_ci95(1.0, 10);
+        assert!(lo > 0.99 && hi <= 1.0);
+        // Equal runs pool to the same r with the interval of all their pairs together.
+        let p = pooled_correlation(&[(0.5, 28), (0.5, 28), (f64::NAN, 40), (0.9, 2)]).unwrap();
+        assert!((p.r - 0.5).abs() < 1e-12);
+        assert_eq!((p.runs, p.pairs), (2, 56));
+        let direct = correlation_ci95(0.5, 53);
+        assert!((p.ci95[0] - direct[0]).abs() < 1e-12 && (p.ci95[1] - direct[1]).abs() < 1e-12);
+        assert!(pooled_correlation(&[(0.2, 3)]).is_none());
+    }
+
+    /// The interval covers the true correlation of bivariate normal samples 95 % of the time.
+    #[test]
+    fn the_interval_covers_the_true_correlation_as_often_as_it_says() {
+        let mut rng = ocellus_image::rng::SplitMix64::new(7);
+        let mut normal = move || {
+            // Box-Muller.
+            let (u, v) = (rng.unit().max(1e-300), rng.unit());
+            (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
+        };
+        let (rho, n, reps) = (0.4f64, 40, 4000);
+        let mut covered = 0;
+        for _ in 0..reps {
+            let pairs: Vec<(f64, f64)> = (0..n)
+                .map(|_| {
+                    let (a, b) = (normal(), normal());
+                    (a, rho * a + (1.0 - rho * rho).sqrt() * b)
+                })
+                .collect();
+            let fields: Vec<Field> = pairs
+                .iter()
+                .map(|&(x, y)| Field { index: 0, centre: [0.0; 2], eccentricity: x, area_px: y, peak: 1.0 })
+                .collect();
+            let [lo, hi] = correlation_ci95(correlation(&fields).0, n);
+            covered += usize::from(lo <= rho && rho <= hi);
+        }
+        // Binomial standard deviation of the share: sqrt(0.95 0.05 / 4000) = 0.0034.
+        let share = covered as f64 / reps as f64;
+        assert!((share - 0.95).abs() < 0.012, "{share}");
     }
 
     #[test]
