@@ -488,7 +488,7 @@ fn summary(a: SummaryArgs) -> Result<()> {
                 "fovea_index_interior": q,
             })).collect::<Vec<_>>(),
         });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        outln!("{}", serde_json::to_string_pretty(&out)?);
         return Ok(());
     }
     for r in &runs {
