@@ -34,7 +34,7 @@ use ocellus_image::Plane;
 pub struct RobustConfig {
     /// The integer search (all windows are used; none is dropped for being on the border).
     pub flow: SadFlowConfig,
-    /// Lucas-Kanade steps per window.
+    /// Lucas-Kanade steps per window (of the final pass; the gain field's pass takes one).
     pub lk_steps: usize,
     /// Side of the square that Lucas-Kanade refines each window's flow over, centred on the
     /// matched block, pixels: at least the block, with the same parity, at most the window.
@@ -348,10 +348,17 @@ struct Refined {
     gain_info: f64,
 }
 
+/// Gauss-Newton steps of the gain pass (see [`RobustConfig::gain_field`]). Only its gains are
+/// used, and one step from the integer match gives them as well as two: on the 42 real-camera
+/// runs one step lowered the summed drift from 0.522 to 0.481 % (easy) and from 1.182 to
+/// 1.046 % (hard), the summed ATE from 0.874 to 0.816 and from 2.615 to 2.461 mm, at half the
+/// pass's cost.
+const GAIN_PASS_STEPS: usize = 1;
+
 impl LkFrames<'_> {
-    /// Gauss-Newton steps of Lucas-Kanade from the integer match `start` with `gain` on the
-    /// current frame; with `free_gain` the window's relative gain is a third unknown: the
-    /// model g (1 - s_g) cur(x + d - s). `None` when a step fails or leaves the pixel around
+    /// Gauss-Newton steps of Lucas-Kanade (`lk_steps`) from the integer match `start` with
+    /// `gain` on the current frame; with `free_gain` the window's relative gain is a third
+    /// unknown, the model g (1 - s_g) cur(x + d - s), in [`GAIN_PASS_STEPS`] steps. `None` when a step fails or leaves the pixel around
     /// `start`.
     fn refine(
         &self,
@@ -366,7 +373,8 @@ impl LkFrames<'_> {
         let (mut dx, mut dy) = start;
         let mut g = gain;
         let mut r = Refined { flow: start, tensor: [[0.0; 2]; 2], residual: 0.0, gain, gain_info: 0.0 };
-        for _ in 0..cfg.lk_steps.max(1) {
+        let steps = if free_gain { GAIN_PASS_STEPS } else { cfg.lk_steps.max(1) };
+        for _ in 0..steps {
             let sums = if free_gain { lk_sums_gain } else { lk_sums };
             let [a11, a12, a22, b1, b2, ee, c1, c2, c3, b3] =
                 sums(cfg.flow.backend, self.prev.plane(), self.cur.plane(), bx, by, b, dx, dy, g, patch);
