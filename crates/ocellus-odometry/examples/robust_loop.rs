@@ -2,6 +2,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 use ocellus_image::Plane;
 use ocellus_odometry::kinematics::Mount;
+use ocellus_odometry::lucas_kanade::SmoothedFrame;
 use ocellus_odometry::vo::{OdometryConfig, VisualOdometry};
 use ocellus_synth::ground::{GroundConfig, GroundScene, GroundTexture};
 
@@ -28,24 +29,51 @@ fn main() {
     }
     t.sort_by(f64::total_cmp);
     println!("robust median {:.3} ms", t[t.len() / 2]);
-    // Stage split: integer search, search + Lucas-Kanade, fit.
+    // Stage split, as a stream does it: smoothing one frame (each frame is smoothed once),
+    // the integer search, the windows' Lucas-Kanade (the search again inside it), the fit.
     let cfg = ocellus_odometry::robust::RobustConfig::default();
-    let (mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new());
+    let (w, h) = frames[0].size();
+    let rect = ocellus_odometry::robust::lk_rect(w, h, &cfg).unwrap();
+    let backend = cfg.flow.backend;
+    let smoothed: Vec<SmoothedFrame> = frames
+        .iter()
+        .map(|f| {
+            let mut s = SmoothedFrame::default();
+            s.update(backend, f, cfg.smooth_sigma_px, rect).unwrap();
+            s
+        })
+        .collect();
+    let mut t = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+    let mut scratch = SmoothedFrame::default();
     for _ in 0..10 {
-        for w in frames.windows(2) {
+        for (k, f) in frames.windows(2).enumerate() {
             let s = std::time::Instant::now();
-            let _ = ocellus_odometry::sad_flow::window_flows(&w[0], &w[1], &cfg.flow).unwrap();
-            a.push(s.elapsed().as_secs_f64() * 1e3);
+            scratch.update(backend, &f[1], cfg.smooth_sigma_px, rect).unwrap();
+            t[0].push(s.elapsed().as_secs_f64() * 1e3);
             let s = std::time::Instant::now();
-            let m = ocellus_odometry::robust::window_measurements(&w[0], &w[1], &cfg).unwrap();
-            b.push(s.elapsed().as_secs_f64() * 1e3);
+            let _ = ocellus_odometry::sad_flow::window_flows(&f[0], &f[1], &cfg.flow).unwrap();
+            t[1].push(s.elapsed().as_secs_f64() * 1e3);
+            let s = std::time::Instant::now();
+            let m = ocellus_odometry::robust::window_measurements_smoothed(
+                &f[0],
+                &f[1],
+                &smoothed[k],
+                &smoothed[k + 1],
+                &cfg,
+            )
+            .unwrap();
+            t[2].push(s.elapsed().as_secs_f64() * 1e3);
             let s = std::time::Instant::now();
             let _ = ocellus_odometry::robust::fit_rigid(&m, &cfg).unwrap();
-            c.push(s.elapsed().as_secs_f64() * 1e3);
+            t[3].push(s.elapsed().as_secs_f64() * 1e3);
         }
     }
-    for v in [&mut a, &mut b, &mut c] {
+    let [a, b, c, d] = t.map(|mut v| {
         v.sort_by(f64::total_cmp);
-    }
-    println!("search {:.3} ms, search + LK {:.3} ms, fit {:.3} ms", a[a.len() / 2], b[b.len() / 2], c[c.len() / 2]);
+        v[v.len() / 2]
+    });
+    println!(
+        "medians: smoothing a frame {a:.3} ms, integer search {b:.3} ms, search + Lucas-Kanade {c:.3} ms (Lucas-Kanade {:.3} ms), fit {d:.3} ms",
+        c - b
+    );
 }
