@@ -181,6 +181,29 @@ fn madd_lanes<M: Madd>(acc: &mut [f32; LANES], a: &[f32; LANES], b: &[f32; LANES
     }
 }
 
+/// The sums of [`lk_sums`] at gain `g0 * ratio` from the ten of [`lk_sums_gain`] at gain `g0`,
+/// at the same offset. With c the warped current patch, cx and cy its gradients and p the
+/// previous one, every sum is a polynomial in the gain g of the gain-free sums: g^2 sum cx^2,
+/// g^2 sum cx c - g sum cx p, g^2 sum c^2 - 2 g sum c p + sum p^2, ...; the ten sums at g0
+/// determine all of them. The last four entries are 0, as from [`lk_sums`].
+pub fn sums_at_gain(s: &[f64; 10], ratio: f64) -> [f64; 10] {
+    let [a11, a12, a22, b1, b2, ee, c1, c2, c3, b3] = *s;
+    let r2 = ratio * ratio;
+    // g0 sum cx p = c1 - b1; g0 sum c p = c3 - b3; sum p^2 = ee + c3 - 2 b3.
+    [
+        r2 * a11,
+        r2 * a12,
+        r2 * a22,
+        r2 * c1 - ratio * (c1 - b1),
+        r2 * c2 - ratio * (c2 - b2),
+        r2 * c3 - 2.0 * ratio * (c3 - b3) + ee + c3 - 2.0 * b3,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+    ]
+}
+
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn lk_sums_generic<M: Madd, const GAIN: bool>(
@@ -338,6 +361,28 @@ mod tests {
                     (got[k] - want[k]).abs() <= 1e-3 * want[k].abs().max(1.0),
                     "{backend:?} {bx} {by} {b}: {got:?} vs {want:?}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn the_sums_at_one_gain_give_those_at_another() {
+        let img = Plane::from_fn(64, 48, |x, y| 100.0 + 30.0 * ((x as f32) * 0.3).sin() * ((y as f32) * 0.2).cos());
+        let cur = Plane::from_fn(64, 48, |x, y| {
+            97.0 + 33.0 * ((x as f32 - 0.4) * 0.3).sin() * ((y as f32 + 0.3) * 0.2).cos()
+        });
+        let mut patch = Vec::new();
+        for (bx, by, dx, dy) in [(20, 15, 1.0, -1.0), (10, 12, 0.4, 0.25)] {
+            let at = lk_sums_gain(Backend::Auto, &img, &cur, bx, by, 16, dx, dy, 1.1, &mut patch);
+            for ratio in [0.9, 1.0, 1.07] {
+                let want = lk_sums(Backend::Auto, &img, &cur, bx, by, 16, dx, dy, 1.1 * ratio, &mut patch);
+                let got = sums_at_gain(&at, ratio);
+                for k in 0..6 {
+                    // Relative to the largest term the sum is made of (f32 sums of ~1e6).
+                    let scale = want[k].abs().max(1e-3 * at[8].abs());
+                    assert!((got[k] - want[k]).abs() <= 1e-4 * scale, "{k} {ratio}: {got:?} vs {want:?}");
+                }
+                assert_eq!(got[6..], [0.0; 4]);
             }
         }
     }

@@ -22,7 +22,7 @@
 //! `r` to the right and `f` forward and turns clockwise by `w`): a floor point at (u, v) in
 //! frame n-1 is seen at `u' = (u - r) cos w + (v + f) sin w`, `v' = -(u - r) sin w + (v + f) cos w`.
 
-use crate::lucas_kanade::{lk_sums, lk_sums_gain, SmoothedFrame, DEFAULT_SMOOTH_SIGMA_PX};
+use crate::lucas_kanade::{lk_sums, lk_sums_gain, sums_at_gain, SmoothedFrame, DEFAULT_SMOOTH_SIGMA_PX};
 use crate::sad_flow::{window_flows, SadFlowConfig};
 use crate::{OdometryError, Result};
 use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
@@ -277,18 +277,22 @@ pub fn window_measurements_smoothed(
     // The gain field (see `RobustConfig::gain_field`): each window's own gain beside its flow
     // first, then one smooth field through those gains; every window is then refined from its
     // integer match again, as without the field, only with the field's gain.
+    // The gain pass's sums at each window's integer match, kept: the final pass's first step
+    // starts from the same match, and its sums follow from these at any gain.
+    let mut first: Vec<Option<[f64; 10]>> = vec![None; todo.len()];
     let field = if cfg.gain_field {
         let mut own = Vec::with_capacity(todo.len());
         // Every other window, in a checkerboard over the grid: about 200 gains fit the six
         // coefficients as well as 400 and cost half (the field pass costs a whole second
         // Lucas-Kanade pass otherwise).
         let pitch = cfg.flow.window as f64;
-        for &(wf, bx, by, start) in &todo {
+        for (k, &(wf, bx, by, start)) in todo.iter().enumerate() {
             if ((wf.x / pitch).floor() + (wf.y / pitch).floor()) as i64 % 2 != 0 {
                 continue;
             }
-            if let Some(r) = frames.refine(bx, by, start, gain, true, &mut patch) {
+            if let Some(r) = frames.refine(bx, by, start, gain, true, None, &mut patch) {
                 own.push([wf.x - cx, wf.y - cy, r.gain / gain, r.gain_info]);
+                first[k] = Some(r.first_sums);
             }
         }
         GainField::fit(&own)
@@ -296,9 +300,10 @@ pub fn window_measurements_smoothed(
         GainField::flat()
     };
     let mut out = Vec::with_capacity(todo.len());
-    for &(wf, bx, by, start) in &todo {
+    for (&(wf, bx, by, start), first) in todo.iter().zip(&first) {
         let (u, v) = (wf.x - cx, wf.y - cy);
-        let Some(r) = frames.refine(bx, by, start, gain * field.at(u, v), false, &mut patch) else {
+        let known = first.as_ref().map(|s| (s, gain));
+        let Some(r) = frames.refine(bx, by, start, gain * field.at(u, v), false, known, &mut patch) else {
             continue;
         };
         // The noise per pixel difference, from this window's own residual, and the flow's
@@ -346,6 +351,8 @@ struct Refined {
     gain: f64,
     /// Information of the relative gain (free gain only), over the noise per pixel.
     gain_info: f64,
+    /// The sums of the first step (free gain only; see [`sums_at_gain`]).
+    first_sums: [f64; 10],
 }
 
 /// Gauss-Newton steps of the gain pass (see [`RobustConfig::gain_field`]). Only its gains are
@@ -359,7 +366,9 @@ impl LkFrames<'_> {
     /// Gauss-Newton steps of Lucas-Kanade (`lk_steps`) from the integer match `start` with
     /// `gain` on the current frame; with `free_gain` the window's relative gain is a third
     /// unknown, the model g (1 - s_g) cur(x + d - s), in [`GAIN_PASS_STEPS`] steps. `None` when a step fails or leaves the pixel around
-    /// `start`.
+    /// `start`. `known`: the ten sums of [`lk_sums_gain`] at `start` with another gain, from
+    /// which the first step's sums follow without reading the frames.
+    #[allow(clippy::too_many_arguments)]
     fn refine(
         &self,
         bx: usize,
@@ -367,17 +376,27 @@ impl LkFrames<'_> {
         start: (f64, f64),
         gain: f64,
         free_gain: bool,
+        known: Option<(&[f64; 10], f64)>,
         patch: &mut Vec<f32>,
     ) -> Option<Refined> {
         let (b, cfg) = (self.cfg.lk_support, self.cfg);
         let (mut dx, mut dy) = start;
         let mut g = gain;
-        let mut r = Refined { flow: start, tensor: [[0.0; 2]; 2], residual: 0.0, gain, gain_info: 0.0 };
+        let mut r =
+            Refined { flow: start, tensor: [[0.0; 2]; 2], residual: 0.0, gain, gain_info: 0.0, first_sums: [0.0; 10] };
         let steps = if free_gain { GAIN_PASS_STEPS } else { cfg.lk_steps.max(1) };
-        for _ in 0..steps {
-            let sums = if free_gain { lk_sums_gain } else { lk_sums };
-            let [a11, a12, a22, b1, b2, ee, c1, c2, c3, b3] =
-                sums(cfg.flow.backend, self.prev.plane(), self.cur.plane(), bx, by, b, dx, dy, g, patch);
+        for step in 0..steps {
+            let all = match known {
+                Some((s, g0)) if step == 0 && !free_gain => sums_at_gain(s, g / g0),
+                _ => {
+                    let sums = if free_gain { lk_sums_gain } else { lk_sums };
+                    sums(cfg.flow.backend, self.prev.plane(), self.cur.plane(), bx, by, b, dx, dy, g, patch)
+                }
+            };
+            if step == 0 {
+                r.first_sums = all;
+            }
+            let [a11, a12, a22, b1, b2, ee, c1, c2, c3, b3] = all;
             let (sx, sy);
             if free_gain {
                 let h = Matrix3::new(a11, a12, c1, a12, a22, c2, c1, c2, c3);
