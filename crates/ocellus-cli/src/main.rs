@@ -27,6 +27,7 @@ mod plot;
 mod ranges;
 mod report_cmd;
 mod retina_cmd;
+mod retina_summary;
 mod rrd;
 mod saliency_cmd;
 mod stereo_cmd;

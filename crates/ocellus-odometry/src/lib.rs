@@ -24,6 +24,7 @@
 //! ```
 
 pub mod fusion;
+mod gain_field;
 pub mod height;
 pub mod kinematics;
 pub mod lucas_kanade;

@@ -22,6 +22,7 @@
 //! `r` to the right and `f` forward and turns clockwise by `w`): a floor point at (u, v) in
 //! frame n-1 is seen at `u' = (u - r) cos w + (v + f) sin w`, `v' = -(u - r) sin w + (v + f) cos w`.
 
+use crate::gain_field::GainField;
 use crate::lucas_kanade::{lk_sums, lk_sums_gain, sums_at_gain, SmoothedFrame, DEFAULT_SMOOTH_SIGMA_PX};
 use crate::sad_flow::{window_flows, SadFlowConfig};
 use crate::{OdometryError, Result};
@@ -434,64 +435,6 @@ impl LkFrames<'_> {
         r.flow = (dx, dy);
         r.gain = g;
         Some(r)
-    }
-}
-
-/// The brightness ratio between the frames over the image, relative to the global gain: a
-/// quadratic in the window position (pixels from the principal point over 256), fitted to
-/// the windows' own gains weighted by their information with Cauchy weights. A lens's
-/// vignetting makes the ratio of a moving floor point's brightness a smooth function of where
-/// it is; one field through hundreds of windows is far less noisy than each window's own gain.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct GainField([f64; 6]);
-
-impl GainField {
-    fn flat() -> Self {
-        Self([1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-    }
-
-    fn basis(u: f64, v: f64) -> [f64; 6] {
-        let (x, y) = (u / 256.0, v / 256.0);
-        [1.0, x, y, x * x, x * y, y * y]
-    }
-
-    fn at(&self, u: f64, v: f64) -> f64 {
-        Self::basis(u, v).iter().zip(&self.0).map(|(a, b)| a * b).sum()
-    }
-
-    /// Fits `[u, v, relative gain, information]` points; flat with fewer than 12 or a
-    /// singular system.
-    fn fit(pts: &[[f64; 4]]) -> Self {
-        if pts.len() < 12 {
-            return Self::flat();
-        }
-        let mut q = Self::flat();
-        // The scale of the Cauchy weights: the median of each point's standard deviation.
-        let mut sd: Vec<f64> = pts.iter().map(|p| 1.0 / p[3].max(1e-300).sqrt()).collect();
-        sd.sort_by(f64::total_cmp);
-        let scale = sd[sd.len() / 2];
-        for _ in 0..4 {
-            let mut a = nalgebra::SMatrix::<f64, 6, 6>::zeros();
-            let mut g = nalgebra::SVector::<f64, 6>::zeros();
-            for p in pts {
-                let e = (p[2] - q.at(p[0], p[1])) / scale;
-                let w = p[3] / (1.0 + e * e);
-                let phi = Self::basis(p[0], p[1]);
-                for r in 0..6 {
-                    for c in 0..6 {
-                        a[(r, c)] += w * phi[r] * phi[c];
-                    }
-                    g[r] += w * phi[r] * p[2];
-                }
-            }
-            let Some(ch) = a.cholesky() else { return Self::flat() };
-            let x = ch.solve(&g);
-            if x.iter().any(|v| !v.is_finite()) {
-                return Self::flat();
-            }
-            q = Self([x[0], x[1], x[2], x[3], x[4], x[5]]);
-        }
-        q
     }
 }
 
