@@ -186,7 +186,7 @@ fn madd_lanes<M: Madd>(acc: &mut [f32; LANES], a: &[f32; LANES], b: &[f32; LANES
 /// previous one, every sum is a polynomial in the gain g of the gain-free sums: g^2 sum cx^2,
 /// g^2 sum cx c - g sum cx p, g^2 sum c^2 - 2 g sum c p + sum p^2, ...; the ten sums at g0
 /// determine all of them. The last four entries are 0, as from [`lk_sums`].
-pub fn sums_at_gain(s: &[f64; 10], ratio: f64) -> [f64; 10] {
+pub(crate) fn sums_at_gain(s: &[f64; 10], ratio: f64) -> [f64; 10] {
     let [a11, a12, a22, b1, b2, ee, c1, c2, c3, b3] = *s;
     let r2 = ratio * ratio;
     // g0 sum cx p = c1 - b1; g0 sum c p = c3 - b3; sum p^2 = ee + c3 - 2 b3.

@@ -79,7 +79,7 @@ pub struct RobustConfig {
     /// so a floor point moving across the frame changes brightness by a ratio that depends on
     /// where it is, and one gain for the whole frame reads that difference as flow (most on a
     /// low-contrast floor, whose gradients are small beside its brightness; vignetting of 25 %
-    /// at the corners moved the fitted shift of the test pattern below by 0.07 %). With the
+    /// at the corners moved the fitted shift of the test pattern below by 0.06 %). With the
     /// field, every other window first fits its own gain beside its flow (a third unknown of
     /// Lucas-Kanade), a quadratic in the position is fitted through those gains weighted by
     /// their information, and every window is refined from its integer match with the field's
@@ -275,12 +275,12 @@ pub fn window_measurements_smoothed(
         let (bx, by) = ((wf.x - half).round().max(0.0) as usize, (wf.y - half).round().max(0.0) as usize);
         todo.push((wf, bx.saturating_sub(ox), by.saturating_sub(oy), (fx as f64, fy as f64)));
     }
-    // The gain field (see `RobustConfig::gain_field`): each window's own gain beside its flow
-    // first, then one smooth field through those gains; every window is then refined from its
-    // integer match again, as without the field, only with the field's gain.
     // The gain pass's sums at each window's integer match, kept: the final pass's first step
     // starts from the same match, and its sums follow from these at any gain.
     let mut first: Vec<Option<[f64; 10]>> = vec![None; todo.len()];
+    // The gain field (see `RobustConfig::gain_field`): each window's own gain beside its flow
+    // first, then one smooth field through those gains; every window is then refined from its
+    // integer match again, as without the field, only with the field's gain.
     let field = if cfg.gain_field {
         let mut own = Vec::with_capacity(todo.len());
         // Every other window, in a checkerboard over the grid: about 200 gains fit the six
@@ -357,7 +357,7 @@ struct Refined {
 }
 
 /// Gauss-Newton steps of the gain pass (see [`RobustConfig::gain_field`]). Only its gains are
-/// used, and one step from the integer match gives them as well as two: on the 42 real-camera
+/// used, and one step from the integer match gives better ones than two: on the 42 real-camera
 /// runs one step lowered the summed drift from 0.522 to 0.481 % (easy) and from 1.182 to
 /// 1.046 % (hard), the summed ATE from 0.874 to 0.816 and from 2.615 to 2.461 mm, at half the
 /// pass's cost.
@@ -366,9 +366,10 @@ const GAIN_PASS_STEPS: usize = 1;
 impl LkFrames<'_> {
     /// Gauss-Newton steps of Lucas-Kanade (`lk_steps`) from the integer match `start` with
     /// `gain` on the current frame; with `free_gain` the window's relative gain is a third
-    /// unknown, the model g (1 - s_g) cur(x + d - s), in [`GAIN_PASS_STEPS`] steps. `None` when a step fails or leaves the pixel around
-    /// `start`. `known`: the ten sums of [`lk_sums_gain`] at `start` with another gain, from
-    /// which the first step's sums follow without reading the frames.
+    /// unknown, the model g (1 - s_g) cur(x + d - s), in [`GAIN_PASS_STEPS`] steps. `None`
+    /// when a step fails or leaves the pixel around `start`. `known`: the ten sums of
+    /// [`lk_sums_gain`] at `start` with another gain, from which the first step's sums follow
+    /// without reading the frames.
     #[allow(clippy::too_many_arguments)]
     fn refine(
         &self,
@@ -394,7 +395,7 @@ impl LkFrames<'_> {
                     sums(cfg.flow.backend, self.prev.plane(), self.cur.plane(), bx, by, b, dx, dy, g, patch)
                 }
             };
-            if step == 0 {
+            if step == 0 && free_gain {
                 r.first_sums = all;
             }
             let [a11, a12, a22, b1, b2, ee, c1, c2, c3, b3] = all;
