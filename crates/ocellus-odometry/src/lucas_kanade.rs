@@ -257,9 +257,30 @@ fn lk_sums_generic<M: Madd, const GAIN: bool>(
             }
         }
     }
+    let x0 = bx.min(prev.width().saturating_sub(b));
+    #[cfg(target_arch = "x86_64")]
+    if M::AVX2 && b % LANES == 0 && b <= prev.width() && patch.len() >= n * n {
+        // SAFETY: `M::AVX2` is true only in kernels compiled for AVX2 and FMA, which
+        // `dispatch_kernel!` runs only on CPUs that have both; the sizes were checked above.
+        let acc = unsafe { x86::sums_avx2::<GAIN>(prev, &patch[..n * n], x0, by, b) };
+        return acc.map(|lanes| lanes.iter().map(|&v| f64::from(v)).sum());
+    }
+    square_sums::<M, GAIN>(prev, patch, x0, by, b).map(|lanes| lanes.iter().map(|&v| f64::from(v)).sum())
+}
+
+/// The lanes of the ten sums of [`lk_sums_generic`] over the `b` x `b` square at (x0, by) of
+/// `prev` against the warped `patch` ((b + 2)^2 values, a one-pixel border).
+#[inline(always)]
+fn square_sums<M: Madd, const GAIN: bool>(
+    prev: &Plane<f32>,
+    patch: &[f32],
+    x0: usize,
+    by: usize,
+    b: usize,
+) -> [[f32; LANES]; 10] {
+    let n = b + 2;
     // acc[k][l]: lane l of sum k; summed over the lanes at the end.
     let mut acc = [[0.0f32; LANES]; 10];
-    let x0 = bx.min(prev.width().saturating_sub(b));
     let full = b / LANES * LANES;
     let lanes = |v: &[f32], at: usize| -> Option<[f32; LANES]> { v.get(at..at + LANES)?.try_into().ok() };
     for j in 1..=b {
@@ -308,12 +329,99 @@ fn lk_sums_generic<M: Madd, const GAIN: bool>(
             }
         }
     }
-    acc.map(|lanes| lanes.iter().map(|&v| f64::from(v)).sum())
+    acc
+}
+
+/// [`square_sums`] by hand in AVX2. Why by hand: the generic loop keeps its
+/// ten sums in `[f32; 8]` arrays, which the AVX-512 build packs in pairs into 512-bit
+/// registers with a shuffle for every multiply-add, plus a bounds test per load. Here each
+/// sum is one 256-bit register and each lane the same chain of fused multiply-adds, in the
+/// same order, as the generic kernel with `Fused`, so the results are bit-identical.
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use super::LANES;
+    use ocellus_image::Plane;
+    use std::arch::x86_64::*;
+
+    /// The lanes of the ten sums over the `b` x `b` square at (x0, by) of `prev` against the
+    /// warped `patch` ((b + 2)^2 values, a one-pixel border); `b` a multiple of 8, at most
+    /// `prev`'s width, and x0 + b within it.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn sums_avx2<const GAIN: bool>(
+        prev: &Plane<f32>,
+        patch: &[f32],
+        x0: usize,
+        by: usize,
+        b: usize,
+    ) -> [[f32; LANES]; 10] {
+        let n = b + 2;
+        let mut acc = [_mm256_setzero_ps(); 10];
+        let half = _mm256_set1_ps(0.5);
+        for j in 1..=b {
+            let prow = &prev.row((by + j - 1).min(prev.height() - 1))[x0..x0 + b];
+            let (up, mid, down) = (&patch[(j - 1) * n..j * n], &patch[j * n..(j + 1) * n], &patch[(j + 1) * n..]);
+            // SAFETY: c + 8 <= b, so the loads read prow[c, c + 8) of b values, mid and up
+            // [c, c + 10) of n = b + 2, and down [c + 1, c + 9) of at least n.
+            unsafe {
+                for c in (0..b).step_by(LANES) {
+                    let m = mid.as_ptr().add(c);
+                    let (left, centre, right) =
+                        (_mm256_loadu_ps(m), _mm256_loadu_ps(m.add(1)), _mm256_loadu_ps(m.add(2)));
+                    let (u, d) = (_mm256_loadu_ps(up.as_ptr().add(c + 1)), _mm256_loadu_ps(down.as_ptr().add(c + 1)));
+                    let p = _mm256_loadu_ps(prow.as_ptr().add(c));
+                    let gx = _mm256_mul_ps(half, _mm256_sub_ps(right, left));
+                    let gy = _mm256_mul_ps(half, _mm256_sub_ps(d, u));
+                    let e = _mm256_sub_ps(centre, p);
+                    acc[0] = _mm256_fmadd_ps(gx, gx, acc[0]);
+                    acc[1] = _mm256_fmadd_ps(gx, gy, acc[1]);
+                    acc[2] = _mm256_fmadd_ps(gy, gy, acc[2]);
+                    acc[3] = _mm256_fmadd_ps(gx, e, acc[3]);
+                    acc[4] = _mm256_fmadd_ps(gy, e, acc[4]);
+                    acc[5] = _mm256_fmadd_ps(e, e, acc[5]);
+                    if GAIN {
+                        acc[6] = _mm256_fmadd_ps(centre, gx, acc[6]);
+                        acc[7] = _mm256_fmadd_ps(centre, gy, acc[7]);
+                        acc[8] = _mm256_fmadd_ps(centre, centre, acc[8]);
+                        acc[9] = _mm256_fmadd_ps(centre, e, acc[9]);
+                    }
+                }
+            }
+        }
+        let mut out = [[0f32; LANES]; 10];
+        for (o, a) in out.iter_mut().zip(&acc) {
+            // SAFETY: `o` holds 8 floats.
+            unsafe { _mm256_storeu_ps(o.as_mut_ptr(), *a) };
+        }
+        out
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The hand-written sums equal the generic loop's with fused multiply-adds bit for bit,
+    /// with and without the gain's sums, on a square at the plane's right edge too.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_sums_equal_the_generic_loop_bit_for_bit() {
+        if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
+            return;
+        }
+        let prev = Plane::from_fn(40, 30, |x, y| ((x * 37 + y * 91) % 113) as f32 * 0.7 + 3.0);
+        for (b, x0, by) in [(8, 3, 2), (16, 10, 5), (16, 24, 13), (24, 16, 0)] {
+            let n = b + 2;
+            let patch: Vec<f32> = (0..n * n).map(|i| ((i * 53) % 97) as f32 * 0.9 + 1.5).collect();
+            let want = square_sums::<ocellus_image::simd::Fused, true>(&prev, &patch, x0, by, b);
+            // SAFETY: AVX2 and FMA were checked above; b is a multiple of 8 within the width.
+            let got = unsafe { x86::sums_avx2::<true>(&prev, &patch, x0, by, b) };
+            assert_eq!(want.map(|l| l.map(f32::to_bits)), got.map(|l| l.map(f32::to_bits)), "b {b} at ({x0}, {by})");
+            let want = square_sums::<ocellus_image::simd::Fused, false>(&prev, &patch, x0, by, b);
+            // SAFETY: as above.
+            let got = unsafe { x86::sums_avx2::<false>(&prev, &patch, x0, by, b) };
+            assert_eq!(want.map(|l| l.map(f32::to_bits)), got.map(|l| l.map(f32::to_bits)), "b {b} at ({x0}, {by})");
+        }
+    }
 
     #[test]
     fn the_sums_are_the_definition() {
