@@ -256,15 +256,17 @@ pub(crate) fn check_kernel(k: &[f32], what: &str) -> Result<()> {
     Ok(())
 }
 
-/// Fills `p` with `row` padded by `hw` values on each side according to `border`.
-fn pad_row(row: &[f32], hw: usize, border: Border, p: &mut Vec<f32>) {
+/// Fills `p` with `row` (as f32) padded by `hw` values on each side according to `border`.
+fn pad_row<T: Copy + Into<f32>>(row: &[T], hw: usize, border: Border, p: &mut Vec<f32>) {
     let w = row.len();
     // Resized, not cleared and refilled: every element is written below, and zeroing the
     // whole row first was a tenth of a smoothing pass.
     p.resize(w + 2 * hw, 0.0);
-    p[hw..hw + w].copy_from_slice(row);
+    for (o, &v) in p[hw..hw + w].iter_mut().zip(row) {
+        *o = v.into();
+    }
     let (first, last) = match border {
-        Border::Clamp if w > 0 => (row[0], row[w - 1]),
+        Border::Clamp if w > 0 => (row[0].into(), row[w - 1].into()),
         _ => (0.0, 0.0),
     };
     p[..hw].fill(first);
@@ -298,19 +300,49 @@ fn filter_rows_generic<M: Madd>(
     let sym = symmetry(kx);
     for y in 0..src.height() {
         pad_row(src.row(y), hwx, border, padded);
-        #[cfg(target_arch = "x86_64")]
-        if M::AVX2 && sym != Symmetry::None {
-            // SAFETY: as in `filter_cols_generic`.
-            if unsafe { x86::correlate_folded_avx2(padded, kx, sym == Symmetry::Odd, dst.row_mut(y)) } {
-                continue;
-            }
-        }
-        correlate_any_generic::<M>(padded, kx, sym, dst.row_mut(y));
+        correlate_row::<M>(padded, kx, sym, dst.row_mut(y));
     }
+}
+
+/// One padded row through `kx` (of symmetry `sym`): the hand-written kernel where it applies.
+#[inline(always)]
+fn correlate_row<M: Madd>(padded: &[f32], kx: &[f32], sym: Symmetry, out: &mut [f32]) {
+    #[cfg(target_arch = "x86_64")]
+    if M::AVX2 && sym != Symmetry::None {
+        // SAFETY: as in `filter_cols_generic`.
+        if unsafe { x86::correlate_folded_avx2(padded, kx, sym == Symmetry::Odd, out) } {
+            return;
+        }
+    }
+    correlate_any_generic::<M>(padded, kx, sym, out);
 }
 
 dispatch_kernel!(fn filter_rows_kernel => filter_rows_generic(
     src: &Plane<f32>, dst: &mut Plane<f32>, kx: &[f32], border: Border, padded: &mut Vec<f32>
+));
+
+/// [`filter_rows_generic`] of the rectangle `[x0, y0, x1, y1]` (checked) of an 8-bit plane,
+/// converted row by row as it is padded.
+#[inline(always)]
+fn filter_rows_u8_generic<M: Madd>(
+    src: &Plane<u8>,
+    rect: [usize; 4],
+    dst: &mut Plane<f32>,
+    kx: &[f32],
+    border: Border,
+    padded: &mut Vec<f32>,
+) {
+    let [x0, y0, x1, y1] = rect;
+    let hwx = (kx.len() - 1) / 2;
+    let sym = symmetry(kx);
+    for y in y0..y1 {
+        pad_row(&src.row(y)[x0..x1], hwx, border, padded);
+        correlate_row::<M>(padded, kx, sym, dst.row_mut(y - y0));
+    }
+}
+
+dispatch_kernel!(fn filter_rows_u8_kernel => filter_rows_u8_generic(
+    src: &Plane<u8>, rect: [usize; 4], dst: &mut Plane<f32>, kx: &[f32], border: Border, padded: &mut Vec<f32>
 ));
 
 #[inline(always)]
@@ -521,6 +553,36 @@ pub fn sep_filter(
     let mut tmp = std::mem::take(&mut scratch.tmp);
     let r = filter_rows(backend, src, &mut tmp, kx, border, scratch)
         .and_then(|_| filter_cols(backend, &tmp, dst, ky, border, scratch));
+    scratch.tmp = tmp;
+    r
+}
+
+/// [`sep_filter`] of the rectangle `rect` = `[x0, y0, x1, y1]` (pixels, end exclusive) of an
+/// 8-bit plane, as if that rectangle were a plane of its own converted to f32 grey levels
+/// (the border rule acts at the rectangle's edges); `dst` resized to the rectangle. The same
+/// values as converting first, without the converted copy.
+#[allow(clippy::too_many_arguments)]
+pub fn sep_filter_u8(
+    backend: Backend,
+    src: &Plane<u8>,
+    rect: [usize; 4],
+    dst: &mut Plane<f32>,
+    kx: &[f32],
+    ky: &[f32],
+    border: Border,
+    scratch: &mut FilterScratch,
+) -> Result<()> {
+    let [x0, y0, x1, y1] = rect;
+    let (w, h) = src.size();
+    if !(x0 < x1 && y0 < y1 && x1 <= w && y1 <= h) {
+        return Err(ImageError::InvalidParameter(format!("rectangle {rect:?} is empty or outside the {w}x{h} plane")));
+    }
+    check_kernel(kx, "horizontal")?;
+    check_kernel(ky, "vertical")?;
+    let mut tmp = std::mem::take(&mut scratch.tmp);
+    tmp.resize(x1 - x0, y1 - y0);
+    filter_rows_u8_kernel(backend, src, rect, &mut tmp, kx, border, &mut scratch.padded);
+    let r = filter_cols(backend, &tmp, dst, ky, border, scratch);
     scratch.tmp = tmp;
     r
 }

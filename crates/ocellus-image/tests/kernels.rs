@@ -2,7 +2,9 @@
 //! available backend against the portable one.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests abort on broken set-up
 
-use ocellus_image::filter::{correlate_2d_direct, filter_cols, filter_rows, sep_filter, Border, FilterScratch};
+use ocellus_image::filter::{
+    correlate_2d_direct, filter_cols, filter_rows, gaussian_kernel, sep_filter, sep_filter_u8, Border, FilterScratch,
+};
 use ocellus_image::preserving::PreservingFilter;
 use ocellus_image::pyramid::{level_sizes, pyr_down, pyr_down_rgb8, PyrScratch, PyramidKernel};
 use ocellus_image::resample::{resize, ResampleMethod};
@@ -168,6 +170,42 @@ fn separable_filters_match_direct_2d() {
         &mut FilterScratch::default()
     )
     .is_err());
+}
+
+#[test]
+fn filtering_an_8_bit_rectangle_equals_converting_it_first() {
+    let img = Plane::from_fn(67, 45, |x, y| ((x * 37 + y * 11 + x * y) % 256) as u8);
+    let k = gaussian_kernel(1.5).unwrap();
+    let skew = [0.1f32, -0.4, 0.7, 1.0, 0.3];
+    for rect in [[0, 0, 67, 45], [5, 3, 60, 41], [20, 10, 29, 12]] {
+        let [x0, y0, x1, y1] = rect;
+        let grey = Plane::from_fn(x1 - x0, y1 - y0, |x, y| f32::from(img.get(x0 + x, y0 + y)));
+        for b in Backend::available() {
+            for (kx, border) in [(&k[..], Border::Clamp), (&skew[..], Border::Zero)] {
+                let (mut want, mut got) = (Plane::default(), Plane::default());
+                sep_filter(b, &grey, &mut want, kx, &k, border, &mut FilterScratch::default()).unwrap();
+                sep_filter_u8(b, &img, rect, &mut got, kx, &k, border, &mut FilterScratch::default()).unwrap();
+                assert_eq!(got, want, "{rect:?} {b:?} {border:?}");
+            }
+        }
+    }
+    let mut dst = Plane::default();
+    for bad in [[0, 0, 68, 45], [10, 5, 10, 9], [3, 40, 9, 30]] {
+        let r = sep_filter_u8(Backend::Auto, &img, bad, &mut dst, &k, &k, Border::Clamp, &mut FilterScratch::default());
+        assert!(r.is_err(), "{bad:?}");
+    }
+    let even = [0.5f32, 0.5];
+    let r = sep_filter_u8(
+        Backend::Auto,
+        &img,
+        [0, 0, 9, 9],
+        &mut dst,
+        &even,
+        &k,
+        Border::Clamp,
+        &mut FilterScratch::default(),
+    );
+    assert!(r.is_err());
 }
 
 #[test]

@@ -17,7 +17,7 @@
 //! pixels summed.
 
 use crate::{OdometryError, Result};
-use ocellus_image::filter::{gaussian_kernel, sep_filter, Border, FilterScratch};
+use ocellus_image::filter::{gaussian_kernel, sep_filter_u8, Border, FilterScratch};
 use ocellus_image::resample::sample_bilinear;
 use ocellus_image::simd::Madd;
 use ocellus_image::{Backend, Plane};
@@ -37,7 +37,6 @@ pub struct SmoothedFrame {
     origin: (usize, usize),
     frame_size: (usize, usize),
     scratch: FilterScratch,
-    grey: Plane<f32>,
 }
 
 impl SmoothedFrame {
@@ -57,15 +56,16 @@ impl SmoothedFrame {
         let reach = kernel.as_ref().map_or(0, |k| k.len() / 2);
         let (cx0, cy0) = (x0.saturating_sub(reach), y0.saturating_sub(reach));
         let (cx1, cy1) = ((x1 + reach).min(w), (y1 + reach).min(h));
-        let target = if kernel.is_some() { &mut self.grey } else { &mut self.plane };
-        target.resize(cx1 - cx0, cy1 - cy0);
-        for y in cy0..cy1 {
-            let src = &frame.row(y)[cx0..cx1];
-            target.row_mut(y - cy0).iter_mut().zip(src).for_each(|(o, &v)| *o = f32::from(v));
-        }
+        let crop = [cx0, cy0, cx1, cy1];
         if let Some(k) = kernel {
-            sep_filter(backend, &self.grey, &mut self.plane, &k, &k, Border::Clamp, &mut self.scratch)
+            sep_filter_u8(backend, frame, crop, &mut self.plane, &k, &k, Border::Clamp, &mut self.scratch)
                 .map_err(|e| OdometryError::Invalid(format!("smoothing sigma {sigma_px}: {e}")))?;
+        } else {
+            self.plane.resize(cx1 - cx0, cy1 - cy0);
+            for y in cy0..cy1 {
+                let src = &frame.row(y)[cx0..cx1];
+                self.plane.row_mut(y - cy0).iter_mut().zip(src).for_each(|(o, &v)| *o = f32::from(v));
+            }
         }
         self.origin = (cx0, cy0);
         self.frame_size = (w, h);
