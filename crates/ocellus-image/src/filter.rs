@@ -257,6 +257,8 @@ pub(crate) fn check_kernel(k: &[f32], what: &str) -> Result<()> {
 }
 
 /// Fills `p` with `row` (as f32) padded by `hw` values on each side according to `border`.
+/// Inlined so that the conversion is compiled with the calling kernel's features.
+#[inline(always)]
 fn pad_row<T: Copy + Into<f32>>(row: &[T], hw: usize, border: Border, p: &mut Vec<f32>) {
     let w = row.len();
     // Resized, not cleared and refilled: every element is written below, and zeroing the
