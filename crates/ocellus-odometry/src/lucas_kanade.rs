@@ -226,6 +226,41 @@ fn lk_sums_generic<M: Madd, const GAIN: bool>(
     // which would not be compiled with this kernel's target features (and was 14 % of a step).
     patch.resize(n * n, 0.0);
     let inside = fx >= 0.0 && fy >= 0.0 && fx as usize + n < cur.width() && fy as usize + n < cur.height();
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: as for `x86::sums_avx2` below; `inside` keeps rows iy..=iy + n, columns
+    // ix..=ix + n in the plane.
+    let done =
+        M::AVX2 && inside && unsafe { x86::patch_avx2(cur, fx as usize, fy as usize, ax, ay, g, &mut patch[..n * n]) };
+    #[cfg(not(target_arch = "x86_64"))]
+    let done = false;
+    if !done {
+        fill_patch(cur, (sx, sy), (fx, fy), (ax, ay), g, inside, n, patch);
+    }
+    let x0 = bx.min(prev.width().saturating_sub(b));
+    #[cfg(target_arch = "x86_64")]
+    if M::AVX2 && b % LANES == 0 && b <= prev.width() && patch.len() >= n * n {
+        // SAFETY: `M::AVX2` is true only in kernels compiled for AVX2 and FMA, which
+        // `dispatch_kernel!` runs only on CPUs that have both; the sizes were checked above.
+        let acc = unsafe { x86::sums_avx2::<GAIN>(prev, &patch[..n * n], x0, by, b) };
+        return acc.map(|lanes| lanes.iter().map(|&v| f64::from(v)).sum());
+    }
+    square_sums::<M, GAIN>(prev, patch, x0, by, b).map(|lanes| lanes.iter().map(|&v| f64::from(v)).sum())
+}
+
+/// The warped patch of [`lk_sums_generic`] (side `n`, the gain `g` applied) with its top-left
+/// at `(sx, sy)` of `cur` (`(fx, fy)` its floor, `(ax, ay)` the fractions), in plain Rust.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn fill_patch(
+    cur: &Plane<f32>,
+    (sx, sy): (f64, f64),
+    (fx, fy): (f64, f64),
+    (ax, ay): (f32, f32),
+    g: f32,
+    inside: bool,
+    n: usize,
+    patch: &mut [f32],
+) {
     if inside && ax == 0.0 && ay == 0.0 {
         // At a whole-pixel offset (the first step from an integer match: half of all calls)
         // the bilinear weights vanish and the patch is the gained pixels themselves; the same
@@ -257,15 +292,6 @@ fn lk_sums_generic<M: Madd, const GAIN: bool>(
             }
         }
     }
-    let x0 = bx.min(prev.width().saturating_sub(b));
-    #[cfg(target_arch = "x86_64")]
-    if M::AVX2 && b % LANES == 0 && b <= prev.width() && patch.len() >= n * n {
-        // SAFETY: `M::AVX2` is true only in kernels compiled for AVX2 and FMA, which
-        // `dispatch_kernel!` runs only on CPUs that have both; the sizes were checked above.
-        let acc = unsafe { x86::sums_avx2::<GAIN>(prev, &patch[..n * n], x0, by, b) };
-        return acc.map(|lanes| lanes.iter().map(|&v| f64::from(v)).sum());
-    }
-    square_sums::<M, GAIN>(prev, patch, x0, by, b).map(|lanes| lanes.iter().map(|&v| f64::from(v)).sum())
 }
 
 /// The lanes of the ten sums of [`lk_sums_generic`] over the `b` x `b` square at (x0, by) of
@@ -342,6 +368,63 @@ mod x86 {
     use super::LANES;
     use ocellus_image::Plane;
     use std::arch::x86_64::*;
+
+    /// The warped patch of [`super::lk_sums_generic`] (side n = `patch.len()`'s root, 8 to 32)
+    /// from the pixels ix..=ix + n, rows iy..=iy + n of `cur` (all inside), the same values:
+    /// each source row is interpolated along x once (not once for each of the two patch rows
+    /// it enters), and the last vector of a row overlaps the one before instead of a scalar
+    /// tail. False (nothing written) for another side.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn patch_avx2(
+        cur: &Plane<f32>,
+        ix: usize,
+        iy: usize,
+        ax: f32,
+        ay: f32,
+        g: f32,
+        patch: &mut [f32],
+    ) -> bool {
+        let n = (patch.len() as f64).sqrt() as usize;
+        if !(8..=32).contains(&n) || n * n != patch.len() || ix + n >= cur.width() || iy + n >= cur.height() {
+            return false;
+        }
+        let vecs = n.div_ceil(8);
+        let at = |v: usize| (8 * v).min(n - 8);
+        let (vax, vay, vg) = (_mm256_set1_ps(ax), _mm256_set1_ps(ay), _mm256_set1_ps(g));
+        let out = patch.as_mut_ptr();
+        // SAFETY (all loads and stores): at(v) + 8 <= n, so a row's loads read columns
+        // ix..=ix + n of rows iy..=iy + n (checked above), and the stores patch[j n, j n + n).
+        unsafe {
+            if ax == 0.0 && ay == 0.0 {
+                for j in 0..n {
+                    let r = cur.row(iy + j).as_ptr().add(ix);
+                    for v in 0..vecs {
+                        _mm256_storeu_ps(out.add(j * n + at(v)), _mm256_mul_ps(vg, _mm256_loadu_ps(r.add(at(v)))));
+                    }
+                }
+                return true;
+            }
+            // Row r interpolated along x: a0 + ax (b0 - a0), as the generic kernel.
+            let along_x = |r: usize, v: usize| {
+                let p = cur.row(iy + r).as_ptr().add(ix + at(v));
+                let (a, b) = (_mm256_loadu_ps(p), _mm256_loadu_ps(p.add(1)));
+                _mm256_add_ps(a, _mm256_mul_ps(vax, _mm256_sub_ps(b, a)))
+            };
+            let mut upper = [_mm256_setzero_ps(); 4];
+            for (v, u) in upper.iter_mut().enumerate().take(vecs) {
+                *u = along_x(0, v);
+            }
+            for j in 0..n {
+                for (v, u) in upper.iter_mut().enumerate().take(vecs) {
+                    let (t, d) = (*u, along_x(j + 1, v));
+                    let o = _mm256_mul_ps(vg, _mm256_add_ps(t, _mm256_mul_ps(vay, _mm256_sub_ps(d, t))));
+                    _mm256_storeu_ps(out.add(j * n + at(v)), o);
+                    *u = d;
+                }
+            }
+        }
+        true
+    }
 
     /// The lanes of the ten sums over the `b` x `b` square at (x0, by) of `prev` against the
     /// warped `patch` ((b + 2)^2 values, a one-pixel border); `b` a multiple of 8, at most
@@ -420,6 +503,45 @@ mod tests {
             // SAFETY: as above.
             let got = unsafe { x86::sums_avx2::<false>(&prev, &patch, x0, by, b) };
             assert_eq!(want.map(|l| l.map(f32::to_bits)), got.map(|l| l.map(f32::to_bits)), "b {b} at ({x0}, {by})");
+        }
+    }
+
+    /// The hand-written patch equals the plain one bit for bit, at whole-pixel and fractional
+    /// offsets and every side it takes; other sides are left to the plain code.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_patch_equals_the_plain_one_bit_for_bit() {
+        if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
+            return;
+        }
+        let cur = Plane::from_fn(50, 45, |x, y| ((x * 29 + y * 71) % 89) as f32 * 1.3 + 0.25);
+        for n in [6usize, 8, 10, 13, 18, 26, 32, 34] {
+            for (ax, ay) in [(0.0f32, 0.0f32), (0.375, 0.0), (0.0, 0.8), (0.62, 0.11)] {
+                let (fx, fy) = (3.0, 5.0);
+                let mut want = vec![0f32; n * n];
+                fill_patch(
+                    &cur,
+                    (fx + f64::from(ax), fy + f64::from(ay)),
+                    (fx, fy),
+                    (ax, ay),
+                    1.07,
+                    true,
+                    n,
+                    &mut want,
+                );
+                let mut got = vec![f32::NAN; n * n];
+                // SAFETY: AVX2 and FMA were checked above.
+                if unsafe { x86::patch_avx2(&cur, 3, 5, ax, ay, 1.07, &mut got) } {
+                    assert!((8..=32).contains(&n));
+                    assert_eq!(
+                        want.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                        got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                        "side {n}, fractions ({ax}, {ay})"
+                    );
+                } else {
+                    assert!(!(8..=32).contains(&n), "side {n} refused");
+                }
+            }
         }
     }
 
