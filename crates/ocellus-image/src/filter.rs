@@ -409,33 +409,32 @@ mod x86 {
         let (ptrs, wts) = (&ptrs[..rows.len()], &wts[..rows.len()]);
         let o = out.as_mut_ptr();
         let mut x = 0;
+        // `L` output vectors of 8 from `x`, one chain each.
+        #[inline(always)]
+        unsafe fn chunk<const L: usize>(ptrs: &[*const f32], wts: &[f32], o: *mut f32, x: usize) {
+            // SAFETY: the caller keeps x + 8 L within every row and the output.
+            unsafe {
+                let mut a = [_mm256_setzero_ps(); L];
+                for (&p, &w) in ptrs.iter().zip(wts) {
+                    let w = _mm256_set1_ps(w);
+                    for (k, a) in a.iter_mut().enumerate() {
+                        *a = _mm256_fmadd_ps(w, _mm256_loadu_ps(p.add(x + 8 * k)), *a);
+                    }
+                }
+                for (k, a) in a.iter().enumerate() {
+                    _mm256_storeu_ps(o.add(x + 8 * k), *a);
+                }
+            }
+        }
         // SAFETY (all loads and stores below): every row holds at least n values (checked
         // above) and every access covers [x, x + 8 * k) with x + 8 * k <= n.
         unsafe {
             while x + 64 <= n {
-                let mut a = [_mm256_setzero_ps(); 8];
-                for (&p, &w) in ptrs.iter().zip(wts) {
-                    let w = _mm256_set1_ps(w);
-                    for (k, a) in a.iter_mut().enumerate() {
-                        *a = _mm256_fmadd_ps(w, _mm256_loadu_ps(p.add(x + 8 * k)), *a);
-                    }
-                }
-                for (k, a) in a.iter().enumerate() {
-                    _mm256_storeu_ps(o.add(x + 8 * k), *a);
-                }
+                chunk::<8>(ptrs, wts, o, x);
                 x += 64;
             }
             while x + 32 <= n {
-                let mut a = [_mm256_setzero_ps(); 4];
-                for (&p, &w) in ptrs.iter().zip(wts) {
-                    let w = _mm256_set1_ps(w);
-                    for (k, a) in a.iter_mut().enumerate() {
-                        *a = _mm256_fmadd_ps(w, _mm256_loadu_ps(p.add(x + 8 * k)), *a);
-                    }
-                }
-                for (k, a) in a.iter().enumerate() {
-                    _mm256_storeu_ps(o.add(x + 8 * k), *a);
-                }
+                chunk::<4>(ptrs, wts, o, x);
                 x += 32;
             }
             // The rest 8 at a time, the last 8 aligned to the end (recomputing a few outputs
