@@ -1,0 +1,133 @@
+//! Hand-written AVX2 kernels for the two passes of a separable filter. Why by hand: the
+//! generic kernels keep their sums in `[f32; 32]` arrays, which LLVM maps well onto 256-bit
+//! registers but, inside the AVX-512 build, into 512-bit registers patched together with
+//! masked inserts and permutes for the odd tap; with only two dependent chains per chunk the
+//! column pass of an 11-tap Gaussian was slower with AVX-512 than with AVX2. Here each
+//! output lane is the same chain of fused multiply-adds, in the same tap order, as in the
+//! generic kernel with [`crate::simd::Fused`] (so the results are bit-identical), and 64
+//! outputs at a time give eight independent chains, enough to hide the multiply-add latency.
+
+use crate::Plane;
+use std::arch::x86_64::*;
+
+/// Most taps these kernels take (the row pointers live on the stack); longer kernels
+/// use the generic code.
+const MAX_TAPS: usize = 64;
+
+/// `out[x] = sum_i w_i * src.row(r_i)[x]`, as `accumulate_rows_generic`; false (nothing
+/// written) where this kernel does not apply: more than [`MAX_TAPS`] rows, or fewer than
+/// 8 outputs.
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn accumulate_rows_avx2(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32]) -> bool {
+    let n = out.len();
+    if rows.len() > MAX_TAPS || n < 8 || src.width() < n {
+        return false;
+    }
+    let mut ptrs = [std::ptr::null::<f32>(); MAX_TAPS];
+    let mut wts = [0f32; MAX_TAPS];
+    for (i, &(r, w)) in rows.iter().enumerate() {
+        ptrs[i] = src.row(r).as_ptr();
+        wts[i] = w;
+    }
+    let (ptrs, wts) = (&ptrs[..rows.len()], &wts[..rows.len()]);
+    let o = out.as_mut_ptr();
+    let mut x = 0;
+    // `L` output vectors of 8 from `x`, one chain each.
+    #[inline(always)]
+    unsafe fn chunk<const L: usize>(ptrs: &[*const f32], wts: &[f32], o: *mut f32, x: usize) {
+        // SAFETY: the caller keeps x + 8 L within every row and the output.
+        unsafe {
+            let mut a = [_mm256_setzero_ps(); L];
+            for (&p, &w) in ptrs.iter().zip(wts) {
+                let w = _mm256_set1_ps(w);
+                for (k, a) in a.iter_mut().enumerate() {
+                    *a = _mm256_fmadd_ps(w, _mm256_loadu_ps(p.add(x + 8 * k)), *a);
+                }
+            }
+            for (k, a) in a.iter().enumerate() {
+                _mm256_storeu_ps(o.add(x + 8 * k), *a);
+            }
+        }
+    }
+    // SAFETY (all loads and stores below): every row holds at least n values (checked
+    // above) and every access covers [x, x + 8 * k) with x + 8 * k <= n.
+    unsafe {
+        while x + 64 <= n {
+            chunk::<8>(ptrs, wts, o, x);
+            x += 64;
+        }
+        while x + 32 <= n {
+            chunk::<4>(ptrs, wts, o, x);
+            x += 32;
+        }
+        // The rest 8 at a time, the last 8 aligned to the end (recomputing a few outputs
+        // with the same result); taps dealt to four running sums in turn, the taps past
+        // the last whole four to the first, as `dot8` does.
+        let quads = ptrs.len() / 4 * 4;
+        while x < n {
+            let x0 = if x + 8 <= n { x } else { n - 8 };
+            let mut a = [_mm256_setzero_ps(); 4];
+            for (t, (&p, &w)) in ptrs.iter().zip(wts).enumerate() {
+                let i = if t < quads { t % 4 } else { 0 };
+                a[i] = _mm256_fmadd_ps(_mm256_set1_ps(w), _mm256_loadu_ps(p.add(x0)), a[i]);
+            }
+            _mm256_storeu_ps(o.add(x0), _mm256_add_ps(_mm256_add_ps(a[0], a[1]), _mm256_add_ps(a[2], a[3])));
+            x = x0 + 8;
+        }
+    }
+    true
+}
+
+/// The folded correlation of a padded row, as `correlate_folded_generic`: `out[x] =
+/// k[h] p[x + h] + sum_t k[h + t] (p[x + h + t] ± p[x + h - t])` (the centre term left
+/// out for an odd kernel). False (nothing written) for fewer than 8 outputs or a `p`
+/// shorter than `out.len() + k.len() - 1`.
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn correlate_folded_avx2(p: &[f32], k: &[f32], odd: bool, out: &mut [f32]) -> bool {
+    let n = out.len();
+    let h = k.len() / 2;
+    if n < 8 || k.is_empty() || p.len() < n + 2 * h {
+        return false;
+    }
+    let (c, o) = (p.as_ptr().wrapping_add(h), out.as_mut_ptr());
+    let kc = _mm256_set1_ps(k[h]);
+    // `L` output vectors of 8 from `x` (`c` points at the centre tap of output 0).
+    #[inline(always)]
+    unsafe fn chunk<const L: usize>(c: *const f32, o: *mut f32, x: usize, k: &[f32], kc: __m256, odd: bool) {
+        let h = k.len() / 2;
+        // SAFETY: the caller keeps x + 8 L <= n, so every load lies in p[x, x + 8 L + 2 h).
+        unsafe {
+            let mut a = [_mm256_setzero_ps(); L];
+            if !odd {
+                for (j, a) in a.iter_mut().enumerate() {
+                    *a = _mm256_mul_ps(kc, _mm256_loadu_ps(c.add(x + 8 * j)));
+                }
+            }
+            for t in 1..=h {
+                let w = _mm256_set1_ps(k[h + t]);
+                for (j, a) in a.iter_mut().enumerate() {
+                    let (sp, sm) = (_mm256_loadu_ps(c.add(x + 8 * j + t)), _mm256_loadu_ps(c.add(x + 8 * j).sub(t)));
+                    let s = if odd { _mm256_sub_ps(sp, sm) } else { _mm256_add_ps(sp, sm) };
+                    *a = _mm256_fmadd_ps(w, s, *a);
+                }
+            }
+            for (j, a) in a.iter().enumerate() {
+                _mm256_storeu_ps(o.add(x + 8 * j), *a);
+            }
+        }
+    }
+    let mut x = 0;
+    // SAFETY: x + 8 L <= n in every call, and p holds n + 2 h values (checked above).
+    unsafe {
+        while x + 32 <= n {
+            chunk::<4>(c, o, x, k, kc, odd);
+            x += 32;
+        }
+        while x < n {
+            let x0 = if x + 8 <= n { x } else { n - 8 };
+            chunk::<1>(c, o, x0, k, kc, odd);
+            x = x0 + 8;
+        }
+    }
+    true
+}
