@@ -290,6 +290,26 @@ pub(crate) fn vertical_taps(y: usize, h: usize, k: &[f32], border: Border, rows:
     }
 }
 
+/// Every row of the rectangle `[x0, y0, x1, y1]` (checked) of `src`, converted to f32 as it
+/// is padded, through `kx` into row `y - y0` of `dst`: the row pass of [`filter_rows`] (the
+/// whole plane) and of [`sep_filter_u8`] (a rectangle of bytes).
+#[inline(always)]
+fn rows_pass<M: Madd, T: Copy + Default + Into<f32>>(
+    src: &Plane<T>,
+    [x0, y0, x1, y1]: [usize; 4],
+    dst: &mut Plane<f32>,
+    kx: &[f32],
+    border: Border,
+    padded: &mut Vec<f32>,
+) {
+    let hwx = (kx.len() - 1) / 2;
+    let sym = symmetry(kx);
+    for y in y0..y1 {
+        pad_row(&src.row(y)[x0..x1], hwx, border, padded);
+        correlate_row::<M>(padded, kx, sym, dst.row_mut(y - y0));
+    }
+}
+
 #[inline(always)]
 fn filter_rows_generic<M: Madd>(
     src: &Plane<f32>,
@@ -298,12 +318,7 @@ fn filter_rows_generic<M: Madd>(
     border: Border,
     padded: &mut Vec<f32>,
 ) {
-    let hwx = (kx.len() - 1) / 2;
-    let sym = symmetry(kx);
-    for y in 0..src.height() {
-        pad_row(src.row(y), hwx, border, padded);
-        correlate_row::<M>(padded, kx, sym, dst.row_mut(y));
-    }
+    rows_pass::<M, f32>(src, [0, 0, src.width(), src.height()], dst, kx, border, padded);
 }
 
 /// One padded row through `kx` (of symmetry `sym`): the hand-written kernel where it applies.
@@ -323,8 +338,6 @@ dispatch_kernel!(fn filter_rows_kernel => filter_rows_generic(
     src: &Plane<f32>, dst: &mut Plane<f32>, kx: &[f32], border: Border, padded: &mut Vec<f32>
 ));
 
-/// [`filter_rows_generic`] of the rectangle `[x0, y0, x1, y1]` (checked) of an 8-bit plane,
-/// converted row by row as it is padded.
 #[inline(always)]
 fn filter_rows_u8_generic<M: Madd>(
     src: &Plane<u8>,
@@ -334,13 +347,7 @@ fn filter_rows_u8_generic<M: Madd>(
     border: Border,
     padded: &mut Vec<f32>,
 ) {
-    let [x0, y0, x1, y1] = rect;
-    let hwx = (kx.len() - 1) / 2;
-    let sym = symmetry(kx);
-    for y in y0..y1 {
-        pad_row(&src.row(y)[x0..x1], hwx, border, padded);
-        correlate_row::<M>(padded, kx, sym, dst.row_mut(y - y0));
-    }
+    rows_pass::<M, u8>(src, rect, dst, kx, border, padded);
 }
 
 dispatch_kernel!(fn filter_rows_u8_kernel => filter_rows_u8_generic(
