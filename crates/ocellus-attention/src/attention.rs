@@ -276,7 +276,7 @@ impl Attention {
         let c = &self.cfg;
         let saccade = self
             .current
-            .map_or(true, |f| separation_deg((az, el), (f.azimuth_deg, f.elevation_deg)) > c.min_saccade_deg);
+            .is_none_or(|f| separation_deg((az, el), (f.azimuth_deg, f.elevation_deg)) > c.min_saccade_deg);
         // Neighbouring map cells of one object share a habituation blob.
         self.habituation.add(az, el, c.habituation_gain, c.habituation_sigma_deg, c.habituation_sigma_deg);
         if self.habituation.value(az, el) >= c.habituation_threshold {

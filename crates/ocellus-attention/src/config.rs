@@ -364,7 +364,7 @@ impl SaliencyConfig {
             return bad(format!("pyramid level {} is too deep (at most 16)", self.max_level()));
         }
         let g = &self.gabor;
-        if g.size == 0 || g.size % 2 == 0 || g.size > 99 {
+        if g.size == 0 || g.size.is_multiple_of(2) || g.size > 99 {
             return bad(format!("gabor.size = {}: must be odd, 1..=99", g.size));
         }
         if !(g.wavelength_px.is_finite() && g.wavelength_px > 0.0 && g.sigma_px.is_finite() && g.sigma_px > 0.0) {

@@ -282,7 +282,7 @@ impl StreamEngine {
             saliency: &self.maps.saliency,
             surprise: self.surprise.map(),
             // Not yet known counts as familiar.
-            familiar: chaos.map_or(true, |s| self.chaos.is_familiar(s)),
+            familiar: chaos.is_none_or(|s| self.chaos.is_familiar(s)),
             chaos,
             fixation,
             inhibition: self.attention.inhibition_map(),

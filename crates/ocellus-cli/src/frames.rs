@@ -80,7 +80,7 @@ pub fn for_each_frame_parallel<S, U: Send>(
         }
         let first = k;
         let mut chunk = Vec::with_capacity(CHUNK);
-        while chunk.len() < CHUNK && limit.map_or(true, |l| k < l) {
+        while chunk.len() < CHUNK && limit.is_none_or(|l| k < l) {
             match frames.next_frame() {
                 Ok(Some(f)) => {
                     k += 1;
@@ -176,7 +176,7 @@ pub fn for_each_frame(
 ) -> Result<usize> {
     let (mut frames, bar) = open_with_progress(input, limit)?;
     let mut k = 0;
-    while limit.map_or(true, |l| k < l) {
+    while limit.is_none_or(|l| k < l) {
         let frame = match frames.next_frame() {
             Ok(Some(fr)) => fr,
             Ok(None) => break,

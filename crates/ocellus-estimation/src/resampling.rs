@@ -234,7 +234,7 @@ pub fn residual(w: &[f64], rng: &mut SplitMix64, out: &mut Vec<usize>) -> Result
     out.clear();
     out.reserve(n);
     for (i, &c) in counts.iter().enumerate() {
-        out.extend(std::iter::repeat(i).take(c));
+        out.extend(std::iter::repeat_n(i, c));
     }
     Ok(())
 }

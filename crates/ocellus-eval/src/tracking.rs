@@ -77,10 +77,10 @@ pub fn score(truth: &[TruthFrame], estimates: &[EstimateFrame]) -> Result<Tracki
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
     for (k, (t, e)) in truth.iter().zip(estimates).enumerate() {
         let ok = finite(&t.position)
-            && t.circle.map_or(true, |c| finite(&c))
+            && t.circle.is_none_or(|c| finite(&c))
             && (0.0..=1.0).contains(&t.visible_fraction)
-            && e.position.map_or(true, |p| finite(&p))
-            && e.centre_px.map_or(true, |p| finite(&p));
+            && e.position.is_none_or(|p| finite(&p))
+            && e.centre_px.is_none_or(|p| finite(&p));
         if !ok {
             return Err(undefined(format!("frame {k} has a non-finite or out-of-range value")));
         }

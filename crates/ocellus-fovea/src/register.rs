@@ -173,7 +173,7 @@ fn spectrum_mode(a: &Plane<f32>, b: &Plane<f32>, opts: &RegisterOptions) -> Resu
     for theta in [angle, angle + PI] {
         let back = warp_similarity(b, -theta, 1.0 / scale);
         let t = phase_correlate(&hann(a, true, true), &hann(&back, true, true))?;
-        if best.map_or(true, |r| t.peak > r.peak) {
+        if best.is_none_or(|r| t.peak > r.peak) {
             // The translation measured in the undone frame, mapped into b's frame.
             let (s, c) = theta.sin_cos();
             let tr = [scale * (c * t.dx - s * t.dy), scale * (s * t.dx + c * t.dy)];

@@ -103,7 +103,7 @@ pub fn block_match(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching) -> Re
 /// `top`: the largest value the images can hold (for the 16-bit cost bound).
 fn block_match_raw(left: &Plane<u8>, right: &Plane<u8>, p: &BlockMatching, top: usize) -> Result<Plane<f32>> {
     ocellus_image::check::same_size("right image (against the left)", right.size(), left.size())?;
-    if p.block % 2 == 0 || p.block < 3 {
+    if p.block.is_multiple_of(2) || p.block < 3 {
         return Err(GeometryError::Invalid(format!("block size {} must be odd and at least 3", p.block)));
     }
     ocellus_image::check::within("max_disparity", p.max_disparity, 1, 256).map_err(GeometryError::Invalid)?;

@@ -244,7 +244,7 @@ pub(crate) fn correlate_any_generic<M: Madd>(p: &[f32], k: &[f32], sym: Symmetry
 }
 
 pub(crate) fn check_kernel(k: &[f32], what: &str) -> Result<()> {
-    if k.is_empty() || k.len() % 2 == 0 {
+    if k.is_empty() || k.len().is_multiple_of(2) {
         return Err(ImageError::InvalidParameter(format!(
             "{what} kernel has {} taps: a centred kernel needs an odd number",
             k.len()

@@ -175,7 +175,7 @@ impl Plane<f32> {
         let mut best: Option<(usize, usize, f32)> = None;
         for (y, r) in self.rows().enumerate() {
             for (x, &v) in r.iter().enumerate() {
-                if best.map_or(true, |b| v > b.2) && !v.is_nan() {
+                if best.is_none_or(|b| v > b.2) && !v.is_nan() {
                     best = Some((x, y, v));
                 }
             }

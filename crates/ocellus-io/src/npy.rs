@@ -56,7 +56,7 @@ pub fn parse(bytes: &[u8], path: &Path) -> Result<NpyArray> {
     // A hostile header can promise more values than any file holds: count without overflow.
     let n = shape.iter().try_fold(1usize, |acc, &d| acc.checked_mul(d)).ok_or_else(|| bad("shape overflows"))?;
     let body = &bytes[hstart + hlen..];
-    if n.checked_mul(size).map_or(true, |b| body.len() < b) {
+    if n.checked_mul(size).is_none_or(|b| body.len() < b) {
         return Err(bad(&format!("{} data bytes for {n} values", body.len())));
     }
     let raw: Vec<f64> = (0..n)

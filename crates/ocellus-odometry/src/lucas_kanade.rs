@@ -238,7 +238,7 @@ fn lk_sums_generic<M: Madd, const GAIN: bool>(
     }
     let x0 = bx.min(prev.width().saturating_sub(b));
     #[cfg(target_arch = "x86_64")]
-    if M::AVX2 && b % LANES == 0 && b <= prev.width() && patch.len() >= n * n {
+    if M::AVX2 && b.is_multiple_of(LANES) && b <= prev.width() && patch.len() >= n * n {
         // SAFETY: `M::AVX2` is true only in kernels compiled for AVX2 and FMA, which
         // `dispatch_kernel!` runs only on CPUs that have both; the sizes were checked above.
         let acc = unsafe { x86::sums_avx2::<GAIN>(prev, &patch[..n * n], x0, by, b) };

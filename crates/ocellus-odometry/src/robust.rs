@@ -94,7 +94,7 @@ impl RobustConfig {
     /// Checks the Lucas-Kanade settings (the search's are checked against each frame).
     pub fn check(&self) -> Result<()> {
         let b = self.flow.block;
-        if self.lk_support < b || self.lk_support > self.flow.window || (self.lk_support - b) % 2 != 0 {
+        if self.lk_support < b || self.lk_support > self.flow.window || !(self.lk_support - b).is_multiple_of(2) {
             return Err(OdometryError::Invalid(format!(
                 "Lucas-Kanade support {}: from the block ({b}) to the window ({}), with the block's parity",
                 self.lk_support, self.flow.window

@@ -64,14 +64,14 @@ impl Default for SadFlowConfig {
 
 impl SadFlowConfig {
     pub(crate) fn check(&self, w: usize, h: usize) -> Result<usize> {
-        if self.block == 0 || self.block >= self.window || (self.window - self.block) % 2 != 0 {
+        if self.block == 0 || self.block >= self.window || !(self.window - self.block).is_multiple_of(2) {
             return Err(OdometryError::Invalid(format!(
                 "block {} in window {}: the block must be smaller, with an even margin",
                 self.block, self.window
             )));
         }
         let n = self.region / self.window;
-        if self.region % self.window != 0 || n < 2 + self.group || (n - 2) % self.group != 0 {
+        if !self.region.is_multiple_of(self.window) || n < 2 + self.group || !(n - 2).is_multiple_of(self.group) {
             return Err(OdometryError::Invalid(format!(
                 "region {} in windows of {}: need a whole number of windows, and after dropping the border a multiple of {} per side",
                 self.region, self.window, self.group

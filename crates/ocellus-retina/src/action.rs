@@ -160,7 +160,7 @@ impl ActionRanges {
             ActionKinds::All => 4,
             _ => 2,
         };
-        if count == 0 || count % (2 * per_axis) != 0 && kinds != ActionKinds::All || count % per_axis != 0 {
+        if count == 0 || !count.is_multiple_of(2 * per_axis) && kinds != ActionKinds::All || !count.is_multiple_of(per_axis) {
             return Err(RetinaError::Invalid(format!(
                 "{count} action values cannot be spread evenly over the {} actions",
                 kinds.name()
@@ -218,7 +218,7 @@ impl ActionRanges {
     /// of `count` not below its square root (60: 10 x 6; 20: 5 x 4).
     pub fn cells(&self, kinds: ActionKinds, count: usize) -> Result<(usize, usize)> {
         self.extent(kinds)?;
-        let nx = (1..=count).find(|&d| count % d == 0 && d * d >= count).ok_or_else(|| {
+        let nx = (1..=count).find(|&d| count.is_multiple_of(d) && d * d >= count).ok_or_else(|| {
             RetinaError::Invalid(format!("{count} motor fields cannot tile the motor space: at least one is needed"))
         })?;
         Ok((nx, count / nx))

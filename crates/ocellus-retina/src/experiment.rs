@@ -285,7 +285,7 @@ pub fn setup<T: Real>(config: &ExperimentConfig, sources: &[Plane<f32>]) -> Resu
         (MotorCode::Cells { nx: cells.0, ny: cells.1, extent }, a, b)
     } else if config.experiment == 1 {
         let values = ranges.discrete(config.actions, config.motor_fields)?;
-        let rep = |k: usize| values.iter().flat_map(|a| std::iter::repeat(*a).take(k)).collect::<Vec<Action>>();
+        let rep = |k: usize| values.iter().flat_map(|a| std::iter::repeat_n(*a, k)).collect::<Vec<Action>>();
         (MotorCode::OneHot(values.clone()), rep(config.triplets), rep(config.heldout))
     } else {
         let extent = ranges.extent(config.actions)?;

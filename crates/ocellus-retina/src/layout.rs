@@ -288,7 +288,7 @@ mod tests {
     fn a_dead_field_is_counted_apart() {
         let disc = Disc::with_pixels(481).unwrap();
         let mut s = blobs(&disc, &[([0.0, 0.0], 2.0), ([5.0, 0.0], 2.0)]);
-        s.extend(std::iter::repeat(0.0).take(481));
+        s.extend(std::iter::repeat_n(0.0, 481));
         let l = measure(&disc, &s, 3).unwrap();
         assert_eq!((l.fields.len(), l.dead), (2, 1));
     }

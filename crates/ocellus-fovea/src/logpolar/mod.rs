@@ -207,7 +207,7 @@ impl LogPolarMap {
     /// Builds the weight table of `cfg` for `width` x `height` images.
     pub fn new(cfg: &LogPolarConfig, width: usize, height: usize) -> Result<Self> {
         cfg.check()?;
-        if width == 0 || height == 0 || width.checked_mul(height).map_or(true, |n| n >= u32::MAX as usize / 4) {
+        if width == 0 || height == 0 || width.checked_mul(height).is_none_or(|n| n >= u32::MAX as usize / 4) {
             return Err(FoveaError::Invalid(format!("image size {width}x{height}")));
         }
         let rows = cfg.fovea_rings + cfg.rings;
