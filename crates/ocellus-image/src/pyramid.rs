@@ -137,6 +137,8 @@ pub struct PyrScratch {
     row3: Vec<f32>,
     even3: [Vec<f32>; 3],
     odd3: [Vec<f32>; 3],
+    row16: Vec<u16>,
+    itaps: Vec<(usize, u16)>,
 }
 
 /// Longest pyramid kernel supported (taps).
@@ -153,20 +155,17 @@ fn decimate_interior_generic<M: Madd>(even: &[f32], odd: &[f32], k: &[f32], orig
         plan[t] = (i.rem_euclid(2) == 1, i.div_euclid(2) as usize, kt);
     }
     let plan = &plan[..k.len().min(MAX_TAPS)];
-    const C: usize = 32;
     let n = out.len();
     let mut j = 0;
-    while j + C <= n {
-        let mut acc = [0f32; C];
-        for &(is_odd, base, kt) in plan {
-            let src = if is_odd { odd } else { even };
-            let s: &[f32; C] = src[base + j..base + j + C].try_into().unwrap_or(&[0.0; C]);
-            for l in 0..C {
-                acc[l] = M::madd(kt, s[l], acc[l]);
-            }
-        }
-        out[j..j + C].copy_from_slice(&acc);
-        j += C;
+    // 64 outputs at a time: eight independent 256-bit chains (four 512-bit), enough to hide
+    // the multiply-add latency over a kernel of six taps; then 32.
+    while j + 64 <= n {
+        decimate_chunk::<M, 64>(even, odd, plan, j, out);
+        j += 64;
+    }
+    while j + 32 <= n {
+        decimate_chunk::<M, 32>(even, odd, plan, j, out);
+        j += 32;
     }
     // 8 at a time, then one 8-wide chunk aligned to the end (recomputes a few outputs).
     while j < n && n >= 8 {
@@ -190,6 +189,26 @@ fn decimate_interior_generic<M: Madd>(even: &[f32], odd: &[f32], k: &[f32], orig
         out[j] = acc;
         j += 1;
     }
+}
+
+/// `C` outputs of [`decimate_interior_generic`] from `j`.
+#[inline(always)]
+fn decimate_chunk<M: Madd, const C: usize>(
+    even: &[f32],
+    odd: &[f32],
+    plan: &[(bool, usize, f32)],
+    j: usize,
+    out: &mut [f32],
+) {
+    let mut acc = [0f32; C];
+    for &(is_odd, base, kt) in plan {
+        let src = if is_odd { odd } else { even };
+        let Ok(s) = <&[f32; C]>::try_from(&src[base + j..base + j + C]) else { return };
+        for l in 0..C {
+            acc[l] = M::madd(kt, s[l], acc[l]);
+        }
+    }
+    out[j..j + C].copy_from_slice(&acc);
 }
 
 /// Splits `row` into even- and odd-indexed samples.
@@ -323,32 +342,148 @@ fn pyr_down_rgb8_generic<M: Madd>(
         s.even3[c].resize(w.div_ceil(2), 0.0);
         s.odd3[c].resize(w / 2, 0.0);
     }
+    let integer = kernel.integer_taps();
+    if integer.is_some() {
+        s.row16.resize(3 * w, 0);
+    }
     for j in 0..d0.height() {
-        vertical_bytes::<M>(src, j, h, kernel, &mut s.taps, &mut s.row3);
-        // Split into even/odd samples per channel (two RGB pixels = 6 values at a time).
         let [e0, e1, e2] = &mut s.even3;
         let [o0, o1, o2] = &mut s.odd3;
         // Plain slices: indexing a Vec inside the loop would reload its header every time.
         let half = w / 2;
         let (e0, e1, e2): (&mut [f32], &mut [f32], &mut [f32]) = (&mut e0[..], &mut e1[..], &mut e2[..]);
         let (o0, o1, o2) = (&mut o0[..half], &mut o1[..half], &mut o2[..half]);
-        for (k, px) in s.row3.chunks_exact(6).take(half).enumerate() {
-            e0[k] = px[0];
-            e1[k] = px[1];
-            e2[k] = px[2];
-            o0[k] = px[3];
-            o1[k] = px[4];
-            o2[k] = px[5];
-        }
-        if w % 2 == 1 {
-            let last = &s.row3[3 * (w - 1)..];
-            e0[w / 2] = last[0];
-            e1[w / 2] = last[1];
-            e2[w / 2] = last[2];
+        if let Some(ik) = &integer {
+            // Exact integer sums of bytes (see `IntegerTaps`), then one scaling to [0, 1] as
+            // the samples are split into even/odd per channel.
+            let d = ik.taps_for(j, h, &mut s.itaps);
+            vertical_bytes_u16(src, &s.itaps, &mut s.row16);
+            let scale = 1.0 / (d as f32 * 255.0);
+            for (k, px) in s.row16.chunks_exact(6).take(half).enumerate() {
+                e0[k] = px[0] as f32 * scale;
+                e1[k] = px[1] as f32 * scale;
+                e2[k] = px[2] as f32 * scale;
+                o0[k] = px[3] as f32 * scale;
+                o1[k] = px[4] as f32 * scale;
+                o2[k] = px[5] as f32 * scale;
+            }
+            if w % 2 == 1 {
+                let last = &s.row16[3 * (w - 1)..];
+                e0[w / 2] = last[0] as f32 * scale;
+                e1[w / 2] = last[1] as f32 * scale;
+                e2[w / 2] = last[2] as f32 * scale;
+            }
+        } else {
+            vertical_bytes::<M>(src, j, h, kernel, &mut s.taps, &mut s.row3);
+            // Split into even/odd samples per channel (two RGB pixels = 6 values at a time).
+            for (k, px) in s.row3.chunks_exact(6).take(half).enumerate() {
+                e0[k] = px[0];
+                e1[k] = px[1];
+                e2[k] = px[2];
+                o0[k] = px[3];
+                o1[k] = px[4];
+                o2[k] = px[5];
+            }
+            if w % 2 == 1 {
+                let last = &s.row3[3 * (w - 1)..];
+                e0[w / 2] = last[0];
+                e1[w / 2] = last[1];
+                e2[w / 2] = last[2];
+            }
         }
         for (c, d) in [&mut *d0, &mut *d1, &mut *d2].into_iter().enumerate() {
             decimate_one::<M>(&s.even3[c], &s.odd3[c], w, kernel, &mut s.taps2, d.row_mut(j));
         }
+    }
+}
+
+/// A pyramid kernel whose taps are `n_t / D` with small integers `n_t` (the seed's
+/// `[1 5 10 10 5 1] / 32`, the toolbox's `/ 33`): on 8-bit input its vertical pass is an
+/// exact sum in 16-bit integers, three times cheaper than converting every byte to float for
+/// each of the taps that reads it, and exact where the float sum rounds at every tap.
+#[derive(Clone, Copy, Debug)]
+struct IntegerTaps {
+    n: [u16; MAX_TAPS],
+    len: usize,
+    origin: usize,
+    stb_size3_rule: bool,
+}
+
+impl PyramidKernel {
+    /// The integer form of the taps, if every tap is within 1e-5 / D of `n_t / D` for integers
+    /// with `D <= 256` (so that `255 D` fits 16 bits). Allocates nothing: it runs per frame.
+    fn integer_taps(&self) -> Option<IntegerTaps> {
+        let taps = self.taps.get(..self.taps.len().min(MAX_TAPS))?;
+        (1..=256u32).find_map(|d| {
+            let exact = taps.iter().all(|t| (t * d as f32 - (t * d as f32).round()).abs() < 1e-5);
+            let sum: f32 = taps.iter().map(|t| (t * d as f32).round()).sum();
+            (exact && sum == d as f32 && taps.len() == self.taps.len()).then(|| {
+                let mut n = [0u16; MAX_TAPS];
+                n.iter_mut().zip(taps).for_each(|(o, t)| *o = (t * d as f32).round() as u16);
+                IntegerTaps { n, len: taps.len(), origin: self.origin, stb_size3_rule: self.stb_size3_rule }
+            })
+        })
+    }
+}
+
+impl IntegerTaps {
+    /// The taps of output `j` of a dimension of `n` samples (those inside it, as
+    /// [`PyramidKernel::taps_for`]), into `out`; returns their sum, the divisor of the output.
+    fn taps_for(&self, j: usize, n: usize, out: &mut Vec<(usize, u16)>) -> u32 {
+        out.clear();
+        if self.stb_size3_rule && n == 3 {
+            out.extend_from_slice(&[(0, 1), (1, 2), (2, 1)]);
+            return 4;
+        }
+        for (t, &k) in self.n[..self.len].iter().enumerate() {
+            let i = (2 * j + t) as isize - self.origin as isize;
+            if i >= 0 && (i as usize) < n && k > 0 {
+                out.push((i as usize, k));
+            }
+        }
+        out.iter().map(|&(_, k)| k as u32).sum::<u32>().max(1)
+    }
+}
+
+/// `out[x] = sum_taps n * byte[x]` over the interleaved bytes of the rows in `taps` (at
+/// most [`MAX_TAPS`]; sums of at most 255 * 256: no overflow), 64 values at a time.
+#[inline(always)]
+fn vertical_bytes_u16(src: &Plane<[u8; 3]>, taps: &[(usize, u16)], out: &mut [u16]) {
+    const C: usize = 64;
+    let mut rows: [(&[u8], u16); MAX_TAPS] = [(&[], 0); MAX_TAPS];
+    for (slot, &(r, k)) in rows.iter_mut().zip(taps) {
+        *slot = (src.row(r).as_flattened(), k);
+    }
+    let rows = &rows[..taps.len().min(MAX_TAPS)];
+    let n = out.len();
+    // A function, not a closure: closures are not compiled with the caller's target features.
+    #[inline(always)]
+    fn chunk(rows: &[(&[u8], u16)], x: usize, out: &mut [u16; C]) {
+        let mut acc = [0u16; C];
+        for &(row, k) in rows {
+            let Some(Ok(b)) = row.get(x..x + C).map(<&[u8; C]>::try_from) else { continue };
+            for l in 0..C {
+                acc[l] = acc[l].wrapping_add(k.wrapping_mul(b[l] as u16));
+            }
+        }
+        *out = acc;
+    }
+    let mut x = 0;
+    while x + C <= n {
+        if let Ok(o) = <&mut [u16; C]>::try_from(&mut out[x..x + C]) {
+            chunk(rows, x, o);
+        }
+        x += C;
+    }
+    if x < n && n >= C {
+        // One chunk aligned to the end; recomputes a few values.
+        if let Ok(o) = <&mut [u16; C]>::try_from(&mut out[n - C..]) {
+            chunk(rows, n - C, o);
+        }
+        x = n;
+    }
+    for (xx, o) in out.iter_mut().enumerate().skip(x) {
+        *o = rows.iter().map(|&(row, k)| k.wrapping_mul(row[xx] as u16)).fold(0, u16::wrapping_add);
     }
 }
 

@@ -116,6 +116,8 @@ fn stb_size3_rule() {
     }
 }
 
+/// The seed's kernel takes the exact 16-bit integer path from bytes, a kernel with an
+/// irrational tap the float path; both must equal the direct definition.
 #[test]
 fn fused_rgb8_level_equals_float_path() {
     let (w, h) = (333, 251);
@@ -124,13 +126,19 @@ fn fused_rgb8_level_equals_float_path() {
         s = s.wrapping_mul(1664525).wrapping_add(1013904223);
         [(s >> 24) as u8, (s >> 16) as u8, (s >> 8) as u8]
     });
-    for b in Backend::available() {
-        let (mut r, mut g, mut bl) = (Plane::default(), Plane::default(), Plane::default());
-        pyr_down_rgb8(b, &rgb, [&mut r, &mut g, &mut bl], &PyramidKernel::itti(), &mut PyrScratch::default()).unwrap();
-        for (c, got) in [r, g, bl].iter().enumerate() {
-            let chan = rgb.map(|p| p[c] as f32 / 255.0);
-            let want = pyr_down_direct(&chan, &[1.0, 5.0, 10.0, 10.0, 5.0, 1.0], 2);
-            assert!(max_abs_diff(got, &want) < 2e-6, "channel {c} {b:?}");
+    let itti = [1.0, 5.0, 10.0, 10.0, 5.0, 1.0];
+    let irrational = [1.0, std::f64::consts::E, 1.7];
+    for (taps, origin) in [(&itti[..], 2), (&irrational[..], 1)] {
+        let taps32: Vec<f32> = taps.iter().map(|&t| t as f32).collect();
+        let kernel = PyramidKernel::new(&taps32, origin, false);
+        for b in Backend::available() {
+            let (mut r, mut g, mut bl) = (Plane::default(), Plane::default(), Plane::default());
+            pyr_down_rgb8(b, &rgb, [&mut r, &mut g, &mut bl], &kernel, &mut PyrScratch::default()).unwrap();
+            for (c, got) in [r, g, bl].iter().enumerate() {
+                let chan = rgb.map(|p| p[c] as f32 / 255.0);
+                let want = pyr_down_direct(&chan, taps, origin);
+                assert!(max_abs_diff(got, &want) < 2e-6, "channel {c} {b:?} taps {taps:?}");
+            }
         }
     }
 }
