@@ -165,7 +165,7 @@ impl Normalizer {
             }
             return Ok(());
         };
-        let (mut mn, mut mx) = lanes_min_max(maps);
+        let (mut mn, mut mx) = lanes_min_max(backend, maps);
         if let Some(r) = range {
             // Clamp at 0, then scale each lane to [0, r] (flat lanes to r / 2).
             mn = mn.map(|v| v.max(0.0));
@@ -183,7 +183,7 @@ impl Normalizer {
             inh.apply_lanes(backend, maps, &mut self.inhib_lanes)?;
             let c: Lanes = match global_inhibition {
                 GlobalInhibition::Constant(c) => [c; 8],
-                GlobalInhibition::RelativeToMax(f) => lanes_min_max(maps).1.map(|m| f * m),
+                GlobalInhibition::RelativeToMax(f) => lanes_min_max(backend, maps).1.map(|m| f * m),
             };
             compete_lanes(backend, maps, &self.excit_lanes, &self.inhib_lanes, c);
         }
@@ -192,7 +192,9 @@ impl Normalizer {
 }
 
 /// Per-lane (min, max).
-fn lanes_min_max(maps: &Plane<Lanes>) -> (Lanes, Lanes) {
+#[inline(always)]
+#[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
+fn lanes_min_max_generic<M: Madd>(maps: &Plane<Lanes>) -> (Lanes, Lanes) {
     let (mut mn, mut mx) = ([f32::INFINITY; 8], [f32::NEG_INFINITY; 8]);
     for r in maps.rows() {
         for p in r {
@@ -204,6 +206,8 @@ fn lanes_min_max(maps: &Plane<Lanes>) -> (Lanes, Lanes) {
     }
     (mn, mx)
 }
+
+dispatch_kernel!(fn lanes_min_max => lanes_min_max_generic(maps: &Plane<Lanes>) -> (Lanes, Lanes));
 
 /// `v <- max(0, v) * scale + offset` per lane.
 #[inline(always)]

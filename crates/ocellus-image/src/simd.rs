@@ -6,8 +6,11 @@
 //! multiply-adds and lets the compiler vectorize with 256-bit registers, and the same inside
 //! `avx512f,avx512bw,avx512vl,avx512dq` for 512-bit registers (and masked loop tails). They
 //! agree to within float rounding (tests check 1e-5). One source per kernel, compiled per
-//! width, rather than hand-written intrinsics per width: the loops are plain slices the
-//! compiler vectorizes fully, and a new width costs one line here.
+//! width: the loops are plain slices the compiler vectorizes, and a new width costs one line
+//! here. Where the compiler's code is not good enough (a few kernels of the filters, the
+//! normalization and odometry), a generic kernel hands over to intrinsics written for one
+//! width, reached through [`Madd::AVX2`] and [`Madd::AVX512`], that give its results bit for
+//! bit (each has a test that compares the bits).
 
 use serde::{Deserialize, Serialize};
 
@@ -152,6 +155,10 @@ pub trait Madd {
     /// `#[target_feature(enable = "avx2")]` helpers (explicit intrinsics) without a further
     /// check.
     const AVX2: bool;
+    /// True for the flavour that [`dispatch_kernel!`] instantiates only inside functions
+    /// compiled with AVX-512 F/BW/VL/DQ (besides AVX2 and FMA): kernels may then call
+    /// `#[target_feature(enable = "avx512f")]` helpers without a further check.
+    const AVX512: bool = false;
     /// `a * b + c`, fused or not.
     fn madd(a: f32, b: f32, c: f32) -> f32;
 }
@@ -176,6 +183,19 @@ impl Madd for Fused {
     }
 }
 
+/// Fused multiply-add inside functions compiled for AVX-512 (which implies AVX2 and FMA):
+/// the same arithmetic as [`Fused`], so the generic kernels give the same results; it only
+/// lets them reach the hand-written 512-bit kernels.
+pub struct Fused512;
+impl Madd for Fused512 {
+    const AVX2: bool = true;
+    const AVX512: bool = true;
+    #[inline(always)]
+    fn madd(a: f32, b: f32, c: f32) -> f32 {
+        a.mul_add(b, c)
+    }
+}
+
 /// Defines `$name(backend, args..) -> ret` that runs `$generic::<Plain>` or, on AVX2 + FMA
 /// (AVX-512) CPUs, `$generic::<Fused>` compiled with those features enabled. Dispatch once
 /// per plane, not per row, so the whole loop nest is compiled for the chosen features.
@@ -193,7 +213,7 @@ macro_rules! dispatch_kernel {
                 }
                 #[target_feature(enable = "avx2,fma,avx512f,avx512bw,avx512vl,avx512dq")]
                 unsafe fn avx512($($arg: $ty),*) $(-> $ret)? {
-                    $generic::<$crate::simd::Fused>($($arg),*)
+                    $generic::<$crate::simd::Fused512>($($arg),*)
                 }
                 match backend.resolve() {
                     // SAFETY: resolve() returns Avx512 only when the CPU has AVX-512 F/BW/VL/DQ, AVX2 and FMA.

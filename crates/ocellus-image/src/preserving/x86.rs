@@ -1,0 +1,196 @@
+//! Hand-written AVX-512 kernel of the energy-preserving filter on eight interleaved maps.
+//!
+//! Why by hand: the generic kernel keeps a pixel's eight lanes in an `[f32; 8]`, which LLVM
+//! maps onto 256-bit registers even inside the AVX-512 build. On a core with full-width
+//! 512-bit units (AMD Zen 5, Intel server cores) one 512-bit register holds two neighbouring
+//! pixels of all eight maps (16 floats, one cache line) and does twice the work per
+//! instruction. That only pays if the loads do not straddle cache lines: a 64-byte load at
+//! an odd pixel splits in two, and with every load split the kernel was no faster than the
+//! 256-bit one. So the padded row is kept twice in 64-byte aligned pairs, starting at even
+//! and at odd pixels, and the horizontal pass's output in aligned pairs too; every load of
+//! the two passes is then one cache line.
+//!
+//! Each output lane is the same chain of fused multiply-adds, in the same tap order, as the
+//! generic kernel with [`crate::simd::Fused`], so the results are bit-identical (tested).
+
+use super::{Lanes, Pair, WideScratch};
+use crate::Plane;
+use std::arch::x86_64::*;
+
+impl WideScratch {
+    /// Buffers for `width` x `height` maps and a kernel of half-width `hw`, with the
+    /// horizontal pass's border factors `fx` in pairs.
+    pub(super) fn new(width: usize, height: usize, hw: usize, fx: &[f32]) -> Self {
+        let off = hw + (hw & 1);
+        let wp = width + (width & 1);
+        // Pairs read: up to pixel wp - 1 + 2 hw - hw + off, plus its neighbour.
+        let pixels = wp + hw + off + 2;
+        let n_even = pixels.div_ceil(2) + 1;
+        let fx_pairs = (0..wp / 2)
+            .map(|q| {
+                let (a, b) = (fx.get(2 * q).copied().unwrap_or(0.0), fx.get(2 * q + 1).copied().unwrap_or(0.0));
+                Pair(std::array::from_fn(|l| if l < 8 { a } else { b }))
+            })
+            .collect();
+        Self {
+            off,
+            even: vec![Pair::default(); n_even],
+            odd: vec![Pair::default(); n_even - 1],
+            tmp: vec![Pair::default(); height * wp / 2],
+            fx_pairs,
+        }
+    }
+}
+
+/// The energy-preserving filter of eight interleaved maps, as `preserving_lanes_generic`:
+/// the horizontal pass of each row (zero border, scaled by `fx`), then the vertical pass
+/// through `rows` (weights already scaled) into `dst`. False (nothing written) where the
+/// buffers do not fit the maps: `s` must come from [`WideScratch::new`] for this size and
+/// kernel.
+///
+/// # Safety
+/// The CPU must have AVX-512 F and DQ (and AVX2 + FMA).
+#[target_feature(enable = "avx512f,avx512dq,avx2,fma")]
+pub(super) unsafe fn preserving_lanes_avx512(
+    k: &[f32],
+    rows: &[Vec<(usize, f32)>],
+    s: &mut WideScratch,
+    src: &Plane<Lanes>,
+    dst: &mut Plane<Lanes>,
+) -> bool {
+    let (w, h) = src.size();
+    let hw = k.len().saturating_sub(1) / 2;
+    let wp = w + (w & 1);
+    let npair = wp / 2;
+    let fits = w >= 2
+        && !k.is_empty()
+        && s.off >= hw
+        && s.even.len() > (wp + hw + s.off + 2).div_ceil(2)
+        && s.odd.len() + 1 == s.even.len()
+        && s.tmp.len() >= h * npair
+        && s.fx_pairs.len() >= npair
+        && rows.len() >= h
+        && dst.size() == (w, h)
+        && rows.iter().take(h).all(|r| r.iter().all(|&(ry, _)| ry < h));
+    if !fits {
+        return false;
+    }
+    let first = s.off - hw;
+    for y in 0..h {
+        // The padded row: pixel x at x + off; everything else stays zero.
+        // SAFETY: off + w <= 2 even.len() pixels (checked above).
+        unsafe {
+            let e = s.even.as_mut_ptr() as *mut f32;
+            std::ptr::copy_nonoverlapping(src.row(y).as_ptr() as *const f32, e.add(s.off * 8), w * 8);
+            let e = s.even.as_ptr() as *const __m512;
+            // Pixels (2q + 1, 2q + 2): the high half of pair q, the low half of pair q + 1.
+            for (q, o) in s.odd.iter_mut().enumerate() {
+                let v = _mm512_shuffle_f32x4::<0x4E>(_mm512_load_ps(e.add(q) as _), _mm512_load_ps(e.add(q + 1) as _));
+                _mm512_store_ps(o.0.as_mut_ptr(), v);
+            }
+        }
+        let out = &mut s.tmp[y * npair..(y + 1) * npair];
+        for (x0, p) in blocks(wp) {
+            // SAFETY: x0 + 2 P <= wp, so the pairs read lie below (wp + hw + off) / 2 + 1
+            // (checked above) and those written below npair.
+            unsafe {
+                match p {
+                    8 => row_block::<8>(&s.even, &s.odd, first, k, &s.fx_pairs, out, x0),
+                    4 => row_block::<4>(&s.even, &s.odd, first, k, &s.fx_pairs, out, x0),
+                    _ => row_block::<1>(&s.even, &s.odd, first, k, &s.fx_pairs, out, x0),
+                }
+            }
+        }
+    }
+    // Vertical pass row by row: the horizontal pass's output (40 x 30 maps: 38 KB) stays in L1.
+    let tmp = s.tmp.as_ptr() as *const f32;
+    for (y, r) in rows.iter().enumerate().take(h) {
+        let out = dst.row_mut(y).as_mut_ptr() as *mut f32;
+        for (x0, p) in blocks(w) {
+            // SAFETY: every tap's row is below h (checked above) and x0 + 2 P <= w <= wp.
+            unsafe {
+                match p {
+                    8 => col_block::<8>(tmp, npair * 16, r, out, x0),
+                    4 => col_block::<4>(tmp, npair * 16, r, out, x0),
+                    _ => col_block::<1>(tmp, npair * 16, r, out, x0),
+                }
+            }
+        }
+    }
+    true
+}
+
+/// The blocks `(x0, pairs)` covering [0, w) (w >= 2): 8 pairs of pixels while they fit, then
+/// 4, then single pairs, the last aligned to the end (a pixel may be computed twice, with the
+/// same result). A plain iterator, not a callback: a closure would not be compiled with the
+/// kernel's target features.
+#[inline(always)]
+fn blocks(w: usize) -> impl Iterator<Item = (usize, usize)> {
+    let mut x = 0;
+    std::iter::from_fn(move || {
+        if x >= w {
+            return None;
+        }
+        let p = if x + 16 <= w {
+            8
+        } else if x + 8 <= w {
+            4
+        } else {
+            1
+        };
+        let x0 = x.min(w - 2);
+        x = x0 + 2 * p;
+        Some((x0, p))
+    })
+}
+
+/// `2 P` outputs of the horizontal pass from the even pixel `x0`: `fx[x] sum_t k[t] p[x + t]`
+/// with `p[i]` padded pixel `i + first` (`first = off - hw`), read as aligned pairs from
+/// `even` or `odd` by the parity of the pixel.
+#[inline(always)]
+unsafe fn row_block<const P: usize>(
+    even: &[Pair],
+    odd: &[Pair],
+    first: usize,
+    k: &[f32],
+    fx: &[Pair],
+    out: &mut [Pair],
+    x0: usize,
+) {
+    // SAFETY: the caller keeps every pair read and written inside the buffers.
+    unsafe {
+        let mut a = [_mm512_setzero_ps(); P];
+        for (t, &kt) in k.iter().enumerate() {
+            let wv = _mm512_set1_ps(kt);
+            let i = x0 + t + first;
+            let base = if i & 1 == 0 { even.as_ptr().add(i / 2) } else { odd.as_ptr().add(i / 2) };
+            for (j, a) in a.iter_mut().enumerate() {
+                *a = _mm512_fmadd_ps(wv, _mm512_load_ps(base.add(j) as *const f32), *a);
+            }
+        }
+        let (f, o) = (fx.as_ptr().add(x0 / 2), out.as_mut_ptr().add(x0 / 2));
+        for (j, a) in a.iter().enumerate() {
+            _mm512_store_ps(o.add(j) as *mut f32, _mm512_mul_ps(*a, _mm512_load_ps(f.add(j) as *const f32)));
+        }
+    }
+}
+
+/// `2 P` outputs of the vertical pass from pixel `x0`: `sum_i w_i tmp[r_i][x]`, rows of
+/// `tmp` `stride` floats apart.
+#[inline(always)]
+unsafe fn col_block<const P: usize>(tmp: *const f32, stride: usize, taps: &[(usize, f32)], out: *mut f32, x0: usize) {
+    // SAFETY: the caller keeps [x0, x0 + 2 P) within the rows and every r_i < height.
+    unsafe {
+        let mut a = [_mm512_setzero_ps(); P];
+        for &(r, wt) in taps {
+            let s = tmp.add(r * stride + x0 * 8);
+            let wv = _mm512_set1_ps(wt);
+            for (j, a) in a.iter_mut().enumerate() {
+                *a = _mm512_fmadd_ps(wv, _mm512_loadu_ps(s.add(16 * j)), *a);
+            }
+        }
+        for (j, a) in a.iter().enumerate() {
+            _mm512_storeu_ps(out.add((x0 + 2 * j) * 8), *a);
+        }
+    }
+}
