@@ -366,6 +366,14 @@ fn filter_cols_generic<M: Madd>(
     for y in 0..h {
         vertical_taps(y, h, ky, border, rows);
         #[cfg(target_arch = "x86_64")]
+        if M::AVX512 {
+            // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512 (with AVX2
+            // and FMA), which `dispatch_kernel!` calls only on CPUs that have them.
+            if unsafe { x86::accumulate_rows_avx512(src, rows, dst.row_mut(y)) } {
+                continue;
+            }
+        }
+        #[cfg(target_arch = "x86_64")]
         if M::AVX2 {
             // SAFETY: `M::AVX2` is true only inside kernels compiled for AVX2 and FMA, which
             // `dispatch_kernel!` calls only on CPUs that have both.
@@ -517,12 +525,12 @@ pub fn correlate_2d_direct(src: &Plane<f32>, k: &[f32], kw: usize, kh: usize, bo
 mod tests {
     use super::*;
 
-    /// The hand-written AVX2 passes give the generic kernels' results bit for bit (the same
+    /// The hand-written AVX2 and AVX-512 passes give the generic kernels' results bit for bit (the same
     /// fused multiply-add chain per output), over widths around every chunk size and kernels
     /// even, odd and longer than the hand-written column pass takes.
     #[cfg(target_arch = "x86_64")]
     #[test]
-    fn avx2_passes_equal_the_generic_kernels_bit_for_bit() {
+    fn hand_written_passes_equal_the_generic_kernels_bit_for_bit() {
         if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
             return;
         }
@@ -542,7 +550,7 @@ mod tests {
                     }
                 })
                 .collect();
-            for w in [7usize, 8, 9, 15, 16, 17, 31, 32, 33, 63, 64, 65, 100, 424] {
+            for w in [7usize, 8, 9, 15, 16, 17, 31, 32, 33, 36, 63, 64, 65, 100, 129, 160, 424] {
                 let src = Plane::from_fn(w, taps + 3, |_, _| (rng.unit() * 255.0) as f32);
                 let mut rows = Vec::new();
                 for y in 0..src.height() {
@@ -556,6 +564,28 @@ mod tests {
                         assert!(same, "columns, {taps} taps, width {w}");
                     } else {
                         assert!(taps > 64 || w < 8, "columns refused {taps} taps at width {w}");
+                    }
+                    if crate::simd::avx512_available() {
+                        // Rows starting at every offset within a cache line: a stride that is
+                        // not a multiple of 16 floats moves each row's start.
+                        let sub = Plane::from_vec_with_stride(w, src.height(), w + 3, {
+                            let mut v = vec![0f32; (w + 3) * src.height()];
+                            for y in 0..src.height() {
+                                v[y * (w + 3)..y * (w + 3) + w].copy_from_slice(src.row(y));
+                            }
+                            v
+                        })
+                        .unwrap_or_else(|e| panic!("{e}"));
+                        for (name, plane) in [("aligned", &src), ("strided", &sub)] {
+                            let mut got = vec![f32::NAN; w];
+                            // SAFETY: AVX-512 was checked just above.
+                            if unsafe { x86::accumulate_rows_avx512(plane, &rows, &mut got) } {
+                                let same = want.iter().zip(&got).all(|(a, b)| a.to_bits() == b.to_bits());
+                                assert!(same, "columns (512, {name}), {taps} taps, width {w}");
+                            } else {
+                                assert!(taps > 64 || w < 8, "512 refused {taps} taps at width {w}");
+                            }
+                        }
                     }
                 }
                 let mut p = Vec::new();

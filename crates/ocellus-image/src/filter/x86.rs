@@ -60,10 +60,20 @@ pub(super) unsafe fn accumulate_rows_avx2(src: &Plane<f32>, rows: &[(usize, f32)
             chunk::<4>(ptrs, wts, o, x);
             x += 32;
         }
-        // The rest 8 at a time, the last 8 aligned to the end (recomputing a few outputs
-        // with the same result); taps dealt to four running sums in turn, the taps past
-        // the last whole four to the first, as `dot8` does.
-        let quads = ptrs.len() / 4 * 4;
+        tail_quads(ptrs, wts, o, x, n);
+    }
+    true
+}
+
+/// Outputs `[x, n)` of `accumulate_rows` (n >= 8) 8 at a time, the last 8 aligned to the
+/// end (recomputing a few outputs, as the generic kernel does); taps dealt to four running
+/// sums in turn, the taps past the last whole four to the first, as `dot8` does.
+#[target_feature(enable = "avx2,fma")]
+unsafe fn tail_quads(ptrs: &[*const f32], wts: &[f32], o: *mut f32, mut x: usize, n: usize) {
+    let quads = ptrs.len() / 4 * 4;
+    // SAFETY: the caller's rows and output hold n >= 8 values; every access covers
+    // [x0, x0 + 8) with x0 + 8 <= n.
+    unsafe {
         while x < n {
             let x0 = if x + 8 <= n { x } else { n - 8 };
             let mut a = [_mm256_setzero_ps(); 4];
@@ -74,6 +84,87 @@ pub(super) unsafe fn accumulate_rows_avx2(src: &Plane<f32>, rows: &[(usize, f32)
             _mm256_storeu_ps(o.add(x0), _mm256_add_ps(_mm256_add_ps(a[0], a[1]), _mm256_add_ps(a[2], a[3])));
             x = x0 + 8;
         }
+    }
+}
+
+/// `accumulate_rows_avx2` with 512-bit registers (16 outputs each) where the generic kernel
+/// keeps one chain per output (the first `32 floor(n / 32)` outputs), then the same tail.
+/// When every row starts at the same offset within a cache line, a masked first vector
+/// brings the rest of the loads onto cache-line boundaries: a 64-byte load that straddles
+/// two lines costs two, and with every load split the 512-bit kernel would gain nothing.
+#[target_feature(enable = "avx512f,avx2,fma")]
+pub(super) unsafe fn accumulate_rows_avx512(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32]) -> bool {
+    let n = out.len();
+    if rows.len() > MAX_TAPS || n < 8 || src.width() < n {
+        return false;
+    }
+    let mut ptrs = [std::ptr::null::<f32>(); MAX_TAPS];
+    let mut wts = [0f32; MAX_TAPS];
+    for (i, &(r, w)) in rows.iter().enumerate() {
+        ptrs[i] = src.row(r).as_ptr();
+        wts[i] = w;
+    }
+    let (ptrs, wts) = (&ptrs[..rows.len()], &wts[..rows.len()]);
+    let o = out.as_mut_ptr();
+    let n32 = n / 32 * 32;
+    let line = |p: *const f32| (p as usize) % 64;
+    let head = match ptrs.first() {
+        Some(&p0) if ptrs.iter().all(|&p| line(p) == line(p0)) => ((64 - line(p0)) % 64 / 4).min(n32),
+        _ => 0,
+    };
+    // `L` output vectors of 16 from `x`, one chain each; `mask` limits the last vector.
+    #[inline(always)]
+    unsafe fn chunk<const L: usize>(ptrs: &[*const f32], wts: &[f32], o: *mut f32, x: usize, mask: __mmask16) {
+        // SAFETY: the caller keeps the unmasked elements within every row and the output.
+        unsafe {
+            let mut a = [_mm512_setzero_ps(); L];
+            for (&p, &w) in ptrs.iter().zip(wts) {
+                let w = _mm512_set1_ps(w);
+                for (k, a) in a.iter_mut().enumerate() {
+                    let v = if k + 1 == L {
+                        _mm512_maskz_loadu_ps(mask, p.add(x + 16 * k))
+                    } else {
+                        _mm512_loadu_ps(p.add(x + 16 * k))
+                    };
+                    *a = _mm512_fmadd_ps(w, v, *a);
+                }
+            }
+            for (k, a) in a.iter().enumerate() {
+                if k + 1 == L {
+                    _mm512_mask_storeu_ps(o.add(x + 16 * k), mask, *a);
+                } else {
+                    _mm512_storeu_ps(o.add(x + 16 * k), *a);
+                }
+            }
+        }
+    }
+    // SAFETY (all loads and stores below): every row holds at least n values (checked
+    // above) and every unmasked access lies in [x, n32) with n32 <= n.
+    unsafe {
+        let mut x = 0;
+        if head > 0 {
+            chunk::<1>(ptrs, wts, o, 0, (1u16 << head) - 1);
+            x = head;
+        }
+        while x + 128 <= n32 {
+            chunk::<8>(ptrs, wts, o, x, !0);
+            x += 128;
+        }
+        if x + 64 <= n32 {
+            chunk::<4>(ptrs, wts, o, x, !0);
+            x += 64;
+        }
+        if x + 32 <= n32 {
+            chunk::<2>(ptrs, wts, o, x, !0);
+            x += 32;
+        }
+        while x < n32 {
+            let left = n32 - x;
+            let mask = if left >= 16 { !0 } else { (1u16 << left) - 1 };
+            chunk::<1>(ptrs, wts, o, x, mask);
+            x += 16.min(left);
+        }
+        tail_quads(ptrs, wts, o, n32, n);
     }
     true
 }
