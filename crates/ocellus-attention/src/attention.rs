@@ -274,9 +274,8 @@ impl Attention {
         let (x, y) = pixel(cx, cy);
         let (az, el) = self.view.direction(x, y, pan_deg, tilt_deg);
         let c = &self.cfg;
-        let saccade = self
-            .current
-            .is_none_or(|f| separation_deg((az, el), (f.azimuth_deg, f.elevation_deg)) > c.min_saccade_deg);
+        let saccade =
+            self.current.is_none_or(|f| separation_deg((az, el), (f.azimuth_deg, f.elevation_deg)) > c.min_saccade_deg);
         // Neighbouring map cells of one object share a habituation blob.
         self.habituation.add(az, el, c.habituation_gain, c.habituation_sigma_deg, c.habituation_sigma_deg);
         if self.habituation.value(az, el) >= c.habituation_threshold {

@@ -133,16 +133,22 @@ pub fn opponent_planes(
     }
 }
 
-/// Intensity, RG and BY planes from R, G, B planes of one pyramid level.
-pub fn opponent_from_planes(rgb: [&Plane<f32>; 3], weights: [f32; 3], threshold: f32, out: [&mut Plane<f32>; 3]) {
+#[inline(always)]
+#[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
+fn opponent_from_planes_generic<M: Madd>(
+    rgb: [&Plane<f32>; 3],
+    weights: [f32; 3],
+    threshold: f32,
+    out: [&mut Plane<f32>; 3],
+) {
     let (w, h) = rgb[0].size();
     let [oi, org, oby] = out;
     oi.resize(w, h);
     org.resize(w, h);
     oby.resize(w, h);
     for y in 0..h {
-        let (r, g, b) = (rgb[0].row(y), rgb[1].row(y), rgb[2].row(y));
-        let (ri, rrg, rby) = (oi.row_mut(y), org.row_mut(y), oby.row_mut(y));
+        let (r, g, b) = (&rgb[0].row(y)[..w], &rgb[1].row(y)[..w], &rgb[2].row(y)[..w]);
+        let (ri, rrg, rby) = (&mut oi.row_mut(y)[..w], &mut org.row_mut(y)[..w], &mut oby.row_mut(y)[..w]);
         for x in 0..w {
             let (i, rg, by) = opponency([r[x], g[x], b[x]], weights, threshold);
             ri[x] = i;
@@ -152,6 +158,12 @@ pub fn opponent_from_planes(rgb: [&Plane<f32>; 3], weights: [f32; 3], threshold:
     }
 }
 
+dispatch_kernel!(
+    /// Intensity, RG and BY planes from R, G, B planes of one pyramid level (the same
+    /// arithmetic as [`opponency`] on every backend: the wider builds only vectorize it).
+    pub fn opponent_from_planes => opponent_from_planes_generic(rgb: [&Plane<f32>; 3], weights: [f32; 3], threshold: f32, out: [&mut Plane<f32>; 3])
+);
+
 /// Skin likelihood plane of an RGB image.
 pub fn skin_plane(img: &RgbImage, threshold: f32, out: &mut Plane<f32>) {
     let (w, h) = img.size();
@@ -160,6 +172,38 @@ pub fn skin_plane(img: &RgbImage, threshold: f32, out: &mut Plane<f32>) {
         let row = out.row_mut(y);
         for (x, o) in row.iter_mut().enumerate() {
             *o = skin_likelihood(img.get_f32(x, y), threshold);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every build of the per-level opponency gives the pixel formula's values bit for bit,
+    /// dark pixels (below the threshold, and black) included.
+    #[test]
+    fn opponent_from_planes_equals_the_pixel_formula_on_every_backend() {
+        let mut rng = ocellus_image::rng::SplitMix64::new(3);
+        let (w, h) = (37, 11);
+        let mut plane = |dark: f64| Plane::from_fn(w, h, |_, _| (rng.unit() * dark) as f32);
+        let rgb = [plane(1.0), plane(0.3), plane(0.05)];
+        for weights in [[1.0 / 3.0; 3], [0.2989, 0.587, 0.114]] {
+            for b in Backend::available() {
+                let (mut i, mut rg, mut by) = (Plane::default(), Plane::default(), Plane::default());
+                opponent_from_planes(b, [&rgb[0], &rgb[1], &rgb[2]], weights, 0.1, [&mut i, &mut rg, &mut by]);
+                for y in 0..h {
+                    for x in 0..w {
+                        let want = opponency([rgb[0].get(x, y), rgb[1].get(x, y), rgb[2].get(x, y)], weights, 0.1);
+                        let got = (i.get(x, y), rg.get(x, y), by.get(x, y));
+                        assert_eq!(
+                            [want.0.to_bits(), want.1.to_bits(), want.2.to_bits()],
+                            [got.0.to_bits(), got.1.to_bits(), got.2.to_bits()],
+                            "{b:?} at ({x}, {y})"
+                        );
+                    }
+                }
+            }
         }
     }
 }

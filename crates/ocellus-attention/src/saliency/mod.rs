@@ -432,6 +432,7 @@ impl SaliencyEngine {
                     for &l in &self.used_levels {
                         let [i, rg, by] = &mut self.pyr.opp;
                         opponent_from_planes(
+                            b,
                             [&self.pyr.rgb[0][l], &self.pyr.rgb[1][l], &self.pyr.rgb[2][l]],
                             weights,
                             cfg.color_threshold,
