@@ -160,7 +160,10 @@ impl ActionRanges {
             ActionKinds::All => 4,
             _ => 2,
         };
-        if count == 0 || !count.is_multiple_of(2 * per_axis) && kinds != ActionKinds::All || !count.is_multiple_of(per_axis) {
+        if count == 0
+            || !count.is_multiple_of(2 * per_axis) && kinds != ActionKinds::All
+            || !count.is_multiple_of(per_axis)
+        {
             return Err(RetinaError::Invalid(format!(
                 "{count} action values cannot be spread evenly over the {} actions",
                 kinds.name()
