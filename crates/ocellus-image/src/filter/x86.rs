@@ -14,14 +14,17 @@ use std::arch::x86_64::*;
 /// use the generic code.
 const MAX_TAPS: usize = 64;
 
-/// `out[x] = sum_i w_i * src.row(r_i)[x]`, as `accumulate_rows_generic`; false (nothing
-/// written) where this kernel does not apply: more than [`MAX_TAPS`] rows, or fewer than
-/// 8 outputs.
-#[target_feature(enable = "avx2,fma")]
-pub(super) unsafe fn accumulate_rows_avx2(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32]) -> bool {
-    let n = out.len();
+/// The rows' first pixels and the weights of `accumulate_rows` for `n` outputs; None where
+/// the hand-written kernels do not apply: more than [`MAX_TAPS`] rows, fewer than 8 outputs,
+/// or rows shorter than `n`.
+#[allow(clippy::type_complexity)]
+fn row_pointers(
+    src: &Plane<f32>,
+    rows: &[(usize, f32)],
+    n: usize,
+) -> Option<([*const f32; MAX_TAPS], [f32; MAX_TAPS])> {
     if rows.len() > MAX_TAPS || n < 8 || src.width() < n {
-        return false;
+        return None;
     }
     let mut ptrs = [std::ptr::null::<f32>(); MAX_TAPS];
     let mut wts = [0f32; MAX_TAPS];
@@ -29,6 +32,16 @@ pub(super) unsafe fn accumulate_rows_avx2(src: &Plane<f32>, rows: &[(usize, f32)
         ptrs[i] = src.row(r).as_ptr();
         wts[i] = w;
     }
+    Some((ptrs, wts))
+}
+
+/// `out[x] = sum_i w_i * src.row(r_i)[x]`, as `accumulate_rows_generic`; false (nothing
+/// written) where this kernel does not apply: more than [`MAX_TAPS`] rows, or fewer than
+/// 8 outputs.
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn accumulate_rows_avx2(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32]) -> bool {
+    let n = out.len();
+    let Some((ptrs, wts)) = row_pointers(src, rows, n) else { return false };
     let (ptrs, wts) = (&ptrs[..rows.len()], &wts[..rows.len()]);
     let o = out.as_mut_ptr();
     let mut x = 0;
@@ -95,15 +108,7 @@ unsafe fn tail_quads(ptrs: &[*const f32], wts: &[f32], o: *mut f32, mut x: usize
 #[target_feature(enable = "avx512f,avx2,fma")]
 pub(super) unsafe fn accumulate_rows_avx512(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32]) -> bool {
     let n = out.len();
-    if rows.len() > MAX_TAPS || n < 8 || src.width() < n {
-        return false;
-    }
-    let mut ptrs = [std::ptr::null::<f32>(); MAX_TAPS];
-    let mut wts = [0f32; MAX_TAPS];
-    for (i, &(r, w)) in rows.iter().enumerate() {
-        ptrs[i] = src.row(r).as_ptr();
-        wts[i] = w;
-    }
+    let Some((ptrs, wts)) = row_pointers(src, rows, n) else { return false };
     let (ptrs, wts) = (&ptrs[..rows.len()], &wts[..rows.len()]);
     let o = out.as_mut_ptr();
     let n32 = n / 32 * 32;
