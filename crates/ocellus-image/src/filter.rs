@@ -260,10 +260,16 @@ pub(crate) fn check_kernel(k: &[f32], what: &str) -> Result<()> {
 /// Inlined so that the conversion is compiled with the calling kernel's features.
 #[inline(always)]
 fn pad_row<T: Copy + Into<f32>>(row: &[T], hw: usize, border: Border, p: &mut Vec<f32>) {
-    let w = row.len();
     // Resized, not cleared and refilled: every element is written below, and zeroing the
     // whole row first was a tenth of a smoothing pass.
-    p.resize(w + 2 * hw, 0.0);
+    p.resize(row.len() + 2 * hw, 0.0);
+    pad_into(row, hw, border, p);
+}
+
+/// [`pad_row`] into a slice of exactly `row.len() + 2 hw` values.
+#[inline(always)]
+fn pad_into<T: Copy + Into<f32>>(row: &[T], hw: usize, border: Border, p: &mut [f32]) {
+    let w = row.len();
     for (o, &v) in p[hw..hw + w].iter_mut().zip(row) {
         *o = v.into();
     }
@@ -304,6 +310,29 @@ fn rows_pass<M: Madd, T: Copy + Default + Into<f32>>(
 ) {
     let hwx = (kx.len() - 1) / 2;
     let sym = symmetry(kx);
+    #[cfg(target_arch = "x86_64")]
+    if M::AVX512 && sym != Symmetry::None && hwx <= x86::FOLDED_512_MAX_HALF {
+        // The padded row placed so that output 0's centre sits on a cache-line boundary,
+        // with room for the aligned vectors read on both sides (see the kernel).
+        let w = x1 - x0;
+        padded.resize(w + 2 * hwx + 96, 0.0);
+        let first = padded.as_ptr() as usize / 4 + hwx;
+        let start = 16 + (16 - first % 16) % 16;
+        let aligned = (padded.as_ptr() as usize).is_multiple_of(4);
+        for y in y0..y1 {
+            pad_into(&src.row(y)[x0..x1], hwx, border, &mut padded[start..start + w + 2 * hwx]);
+            // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512, which
+            // `dispatch_kernel!` calls only on CPUs that have it.
+            let done = aligned
+                && unsafe {
+                    x86::correlate_folded_avx512(padded, start, kx, sym == Symmetry::Odd, dst.row_mut(y - y0))
+                };
+            if !done {
+                correlate_row::<M>(&padded[start..start + w + 2 * hwx], kx, sym, dst.row_mut(y - y0));
+            }
+        }
+        return;
+    }
     for y in y0..y1 {
         pad_row(&src.row(y)[x0..x1], hwx, border, padded);
         correlate_row::<M>(padded, kx, sym, dst.row_mut(y - y0));
@@ -535,7 +564,7 @@ mod tests {
             return;
         }
         let mut rng = crate::rng::SplitMix64::new(11);
-        for taps in [1usize, 3, 5, 11, 29, 67] {
+        for taps in [1usize, 3, 5, 11, 29, 31, 33, 67] {
             let h = taps / 2;
             let half: Vec<f32> = (0..=h).map(|_| rng.unit() as f32 - 0.3).collect();
             let even: Vec<f32> = (0..taps).map(|t| half[t.abs_diff(h)]).collect();
@@ -599,6 +628,14 @@ mod tests {
                         assert!(same, "rows, {taps} taps (odd: {is_odd}), width {w}");
                     } else {
                         assert!(w < 8, "rows refused {taps} taps at width {w}");
+                    }
+                    if crate::simd::avx512_available() {
+                        // The whole row pass as the AVX-512 build runs it (aligned layout).
+                        let mut all = Plane::default();
+                        filter_rows(Backend::Avx512, &src, &mut all, k, Border::Clamp, &mut FilterScratch::default())
+                            .unwrap_or_else(|e| panic!("{e}"));
+                        let same = want.iter().zip(all.row(1)).all(|(a, b)| a.to_bits() == b.to_bits());
+                        assert!(same, "rows (512), {taps} taps (odd: {is_odd}), width {w}");
                     }
                 }
             }

@@ -227,3 +227,134 @@ pub(super) unsafe fn correlate_folded_avx2(p: &[f32], k: &[f32], odd: bool, out:
     }
     true
 }
+
+/// Longest half-width `h` that [`correlate_folded_avx512`] takes (kernels of up to 33 taps):
+/// every tap then reads from the aligned vectors just before, at and after an output's.
+pub(super) const FOLDED_512_MAX_HALF: usize = 16;
+
+/// The folded correlation of a padded row, as `correlate_folded_generic`, with 512-bit
+/// registers and every load on a cache-line boundary. Why: with a row shifted by every tap
+/// offset in turn, a 64-byte load straddles two cache lines 15 times out of 16 and costs two;
+/// here each output vector loads the aligned vectors before, at and after it once, and the
+/// shifted ones are cut from them (`valignd`). The padded row is `buf[start..]` (`p` of the
+/// generic kernel, `out.len() + 2 h` values); the caller places it so that
+/// `buf[start + h]` (output 0's centre) is 64-byte aligned, with 16 values of room before
+/// it and 48 after `buf[start + h + out.len()]`. False (nothing written) otherwise, and for
+/// fewer than 8 outputs.
+#[target_feature(enable = "avx512f,avx2,fma")]
+pub(super) unsafe fn correlate_folded_avx512(buf: &[f32], start: usize, k: &[f32], odd: bool, out: &mut [f32]) -> bool {
+    let n = out.len();
+    let h = k.len() / 2;
+    let c = buf.as_ptr().wrapping_add(start + h);
+    // Below 8 outputs the generic kernel sums in another order; it keeps them.
+    if n < 8
+        || k.len().is_multiple_of(2)
+        || h > FOLDED_512_MAX_HALF
+        || start + h < 16
+        || !(c as usize).is_multiple_of(64)
+    {
+        return false;
+    }
+    if buf.len() < start + h + n.div_ceil(16) * 16 + 32 {
+        return false;
+    }
+    // Taps as broadcast registers, the centre first.
+    let mut w = [_mm512_setzero_ps(); FOLDED_512_MAX_HALF + 1];
+    for (t, w) in w.iter_mut().enumerate().take(h + 1) {
+        *w = _mm512_set1_ps(k[h + t]);
+    }
+    let o = out.as_mut_ptr();
+    let nv = n.div_ceil(16);
+    // SAFETY: vector v reads buf[start + h + 16 (v - 1) .. start + h + 16 (v + 2)], inside
+    // buf for v < nv (checked above); stores write out[16 v ..] masked to n.
+    unsafe {
+        let mut v = 0;
+        while v + 4 <= nv {
+            folded_vectors::<4>(c, o, v, n, &w, h, odd);
+            v += 4;
+        }
+        while v < nv {
+            folded_vectors::<1>(c, o, v, n, &w, h, odd);
+            v += 1;
+        }
+    }
+    true
+}
+
+/// Output vectors `v0 .. v0 + L` of [`correlate_folded_avx512`]: for each, `w[0] c + sum_t
+/// w[t] (c[+t] ± c[-t])` (the centre term left out for an odd kernel), the shifted vectors
+/// cut from the aligned ones before (`m`), at (`a`) and after (`b`) it.
+#[inline(always)]
+unsafe fn folded_vectors<const L: usize>(
+    c: *const f32,
+    o: *mut f32,
+    v0: usize,
+    n: usize,
+    w: &[__m512; FOLDED_512_MAX_HALF + 1],
+    h: usize,
+    odd: bool,
+) {
+    // SAFETY: the caller keeps the three aligned vectors of each output inside the buffer.
+    unsafe {
+        let mut m = [_mm512_setzero_ps(); L];
+        let mut a = [_mm512_setzero_ps(); L];
+        let mut b = [_mm512_setzero_ps(); L];
+        let mut acc = [_mm512_setzero_ps(); L];
+        for j in 0..L {
+            let x = 16 * (v0 + j);
+            m[j] = _mm512_load_ps(c.add(x).sub(16));
+            a[j] = _mm512_load_ps(c.add(x));
+            b[j] = _mm512_load_ps(c.add(x + 16));
+            if !odd {
+                acc[j] = _mm512_mul_ps(w[0], a[j]);
+            }
+        }
+        // One tap: its two shifted vectors from `valignd` with immediate offsets, so each
+        // tap is written out once per offset.
+        macro_rules! tap {
+            ($t:literal) => {
+                if $t <= h {
+                    for j in 0..L {
+                        let sp = _mm512_castsi512_ps(_mm512_alignr_epi32::<$t>(
+                            _mm512_castps_si512(b[j]),
+                            _mm512_castps_si512(a[j]),
+                        ));
+                        let sm = _mm512_castsi512_ps(_mm512_alignr_epi32::<{ 16 - $t }>(
+                            _mm512_castps_si512(a[j]),
+                            _mm512_castps_si512(m[j]),
+                        ));
+                        let s = if odd { _mm512_sub_ps(sp, sm) } else { _mm512_add_ps(sp, sm) };
+                        acc[j] = _mm512_fmadd_ps(w[$t], s, acc[j]);
+                    }
+                }
+            };
+        }
+        tap!(1);
+        tap!(2);
+        tap!(3);
+        tap!(4);
+        tap!(5);
+        tap!(6);
+        tap!(7);
+        tap!(8);
+        tap!(9);
+        tap!(10);
+        tap!(11);
+        tap!(12);
+        tap!(13);
+        tap!(14);
+        tap!(15);
+        if h >= 16 {
+            for j in 0..L {
+                let s = if odd { _mm512_sub_ps(b[j], m[j]) } else { _mm512_add_ps(b[j], m[j]) };
+                acc[j] = _mm512_fmadd_ps(w[16], s, acc[j]);
+            }
+        }
+        for j in 0..L {
+            let x = 16 * (v0 + j);
+            let left = n - x;
+            let mask = if left >= 16 { !0u16 } else { (1u16 << left) - 1 };
+            _mm512_mask_storeu_ps(o.add(x), mask, acc[j]);
+        }
+    }
+}
