@@ -392,6 +392,14 @@ fn filter_cols_generic<M: Madd>(
     rows: &mut Vec<(usize, f32)>,
 ) {
     let h = src.height();
+    #[cfg(target_arch = "x86_64")]
+    if M::AVX512 && border == Border::Clamp {
+        // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512 (with AVX2
+        // and FMA), which `dispatch_kernel!` calls only on CPUs that have them.
+        if unsafe { x86::filter_cols_clamp_avx512(src, dst, ky) } {
+            return;
+        }
+    }
     for y in 0..h {
         vertical_taps(y, h, ky, border, rows);
         #[cfg(target_arch = "x86_64")]
@@ -582,6 +590,12 @@ mod tests {
             for w in [7usize, 8, 9, 15, 16, 17, 31, 32, 33, 36, 63, 64, 65, 100, 129, 160, 424] {
                 let src = Plane::from_fn(w, taps + 3, |_, _| (rng.unit() * 255.0) as f32);
                 let mut rows = Vec::new();
+                // The whole column pass as the AVX-512 build runs it (two rows at a time).
+                let mut all = Plane::default();
+                if crate::simd::avx512_available() {
+                    filter_cols(Backend::Avx512, &src, &mut all, &even, Border::Clamp, &mut FilterScratch::default())
+                        .unwrap_or_else(|e| panic!("{e}"));
+                }
                 for y in 0..src.height() {
                     vertical_taps(y, src.height(), &even, Border::Clamp, &mut rows);
                     let (mut want, mut got) = (vec![0f32; w], vec![f32::NAN; w]);
@@ -595,6 +609,8 @@ mod tests {
                         assert!(taps > 64 || w < 8, "columns refused {taps} taps at width {w}");
                     }
                     if crate::simd::avx512_available() {
+                        let same = want.iter().zip(all.row(y)).all(|(a, b)| a.to_bits() == b.to_bits());
+                        assert!(same, "column pass (512), {taps} taps, width {w}, row {y}");
                         // Rows starting at every offset within a cache line: a stride that is
                         // not a multiple of 16 floats moves each row's start.
                         let sub = Plane::from_vec_with_stride(w, src.height(), w + 3, {
