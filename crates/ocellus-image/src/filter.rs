@@ -136,7 +136,7 @@ pub(crate) fn accumulate_rows_generic<M: Madd>(src: &Plane<f32>, rows: &[(usize,
 
 dispatch_kernel!(
     /// `out[x] = sum_i w_i * src.row(r_i)[x]`: a weighted sum of rows.
-    pub fn accumulate_rows => accumulate_rows_generic(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32])
+    pub fn accumulate_rows => accumulate_rows_best(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32])
 );
 
 /// Symmetry of a centred kernel: `k[h+t] = k[h-t]` (even) or `k[h+t] = -k[h-t]` (odd).
@@ -352,7 +352,7 @@ fn filter_rows_generic<M: Madd>(
 
 /// One padded row through `kx` (of symmetry `sym`): the hand-written kernel where it applies.
 #[inline(always)]
-fn correlate_row<M: Madd>(padded: &[f32], kx: &[f32], sym: Symmetry, out: &mut [f32]) {
+pub(crate) fn correlate_row<M: Madd>(padded: &[f32], kx: &[f32], sym: Symmetry, out: &mut [f32]) {
     #[cfg(target_arch = "x86_64")]
     if M::AVX2 && sym != Symmetry::None {
         // SAFETY: as in `filter_cols_generic`.
@@ -402,24 +402,31 @@ fn filter_cols_generic<M: Madd>(
     }
     for y in 0..h {
         vertical_taps(y, h, ky, border, rows);
-        #[cfg(target_arch = "x86_64")]
-        if M::AVX512 {
-            // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512 (with AVX2
-            // and FMA), which `dispatch_kernel!` calls only on CPUs that have them.
-            if unsafe { x86::accumulate_rows_avx512(src, rows, dst.row_mut(y)) } {
-                continue;
-            }
-        }
-        #[cfg(target_arch = "x86_64")]
-        if M::AVX2 {
-            // SAFETY: `M::AVX2` is true only inside kernels compiled for AVX2 and FMA, which
-            // `dispatch_kernel!` calls only on CPUs that have both.
-            if unsafe { x86::accumulate_rows_avx2(src, rows, dst.row_mut(y)) } {
-                continue;
-            }
-        }
-        accumulate_rows_generic::<M>(src, rows, dst.row_mut(y));
+        accumulate_rows_best::<M>(src, rows, dst.row_mut(y));
     }
+}
+
+/// [`accumulate_rows_generic`] through the hand-written kernel of the build where one
+/// applies (the same results bit for bit).
+#[inline(always)]
+pub(crate) fn accumulate_rows_best<M: Madd>(src: &Plane<f32>, rows: &[(usize, f32)], out: &mut [f32]) {
+    #[cfg(target_arch = "x86_64")]
+    if M::AVX512 {
+        // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512 (with AVX2
+        // and FMA), which `dispatch_kernel!` calls only on CPUs that have them.
+        if unsafe { x86::accumulate_rows_avx512(src, rows, out) } {
+            return;
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    if M::AVX2 {
+        // SAFETY: `M::AVX2` is true only inside kernels compiled for AVX2 and FMA, which
+        // `dispatch_kernel!` calls only on CPUs that have both.
+        if unsafe { x86::accumulate_rows_avx2(src, rows, out) } {
+            return;
+        }
+    }
+    accumulate_rows_generic::<M>(src, rows, out);
 }
 
 dispatch_kernel!(fn filter_cols_kernel => filter_cols_generic(

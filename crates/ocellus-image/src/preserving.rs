@@ -2,9 +2,7 @@
 //! kernel truncated at the border and renormalized (Walther & Koch 2006,
 //! `sepConv2PreserveEnergy`), for one map or for eight maps interleaved in SIMD lanes.
 
-use crate::filter::{
-    accumulate_rows_generic, check_kernel, correlate_any_generic, symmetry, vertical_taps, Border, Symmetry,
-};
+use crate::filter::{accumulate_rows_best, check_kernel, correlate_row, symmetry, vertical_taps, Border, Symmetry};
 use crate::simd::Madd;
 use crate::{dispatch_kernel, Backend, ImageError, Plane, Result};
 
@@ -263,13 +261,13 @@ fn preserving_generic<M: Madd>(
     for y in 0..src.height() {
         padded[hw..hw + w].copy_from_slice(src.row(y));
         let out = tmp.row_mut(y);
-        correlate_any_generic::<M>(padded, k, sym, out);
+        correlate_row::<M>(padded, k, sym, out);
         for (o, f) in out.iter_mut().zip(fx) {
             *o *= f;
         }
     }
     for (y, r) in rows.iter().enumerate() {
-        accumulate_rows_generic::<M>(tmp, r, dst.row_mut(y));
+        accumulate_rows_best::<M>(tmp, r, dst.row_mut(y));
     }
 }
 

@@ -5,7 +5,7 @@
 //! output length is `floor(n / 2)`. Where taps fall outside the image they are dropped and
 //! the remaining taps renormalized to sum 1 (the seed's [10 10 5 1]/26 rule, generalized).
 
-use crate::filter::accumulate_rows_generic;
+use crate::filter::accumulate_rows_best;
 use crate::simd::Madd;
 use crate::{dispatch_kernel, Backend, ImageError, Plane, Result};
 use serde::{Deserialize, Serialize};
@@ -282,7 +282,7 @@ fn pyr_down_generic<M: Madd>(src: &Plane<f32>, dst: &mut Plane<f32>, kernel: &Py
     s.vert.resize(w, oh);
     for j in 0..oh {
         kernel.taps_for(j, h, &mut s.taps);
-        accumulate_rows_generic::<M>(src, &s.taps, s.vert.row_mut(j));
+        accumulate_rows_best::<M>(src, &s.taps, s.vert.row_mut(j));
     }
     dst.resize(ow, oh);
     decimate_rows::<M>(&s.vert, dst, kernel, &mut s.even, &mut s.odd, &mut s.taps);
