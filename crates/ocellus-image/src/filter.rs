@@ -393,10 +393,15 @@ fn filter_cols_generic<M: Madd>(
 ) {
     let h = src.height();
     #[cfg(target_arch = "x86_64")]
-    if M::AVX512 && border == Border::Clamp {
-        // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512 (with AVX2
-        // and FMA), which `dispatch_kernel!` calls only on CPUs that have them.
-        if unsafe { x86::filter_cols_clamp_avx512(src, dst, ky) } {
+    if border == Border::Clamp {
+        // SAFETY: `M::AVX512` (`M::AVX2`) is true only inside kernels compiled for AVX-512
+        // (AVX2 and FMA), which `dispatch_kernel!` calls only on CPUs that have them.
+        let done = if M::AVX512 {
+            unsafe { column_pairs::cols_clamp_avx512(src, dst, ky) }
+        } else {
+            M::AVX2 && unsafe { column_pairs::cols_clamp_avx2(src, dst, ky) }
+        };
+        if done {
             return;
         }
     }
@@ -433,6 +438,8 @@ dispatch_kernel!(fn filter_cols_kernel => filter_cols_generic(
     src: &Plane<f32>, dst: &mut Plane<f32>, ky: &[f32], border: Border, rows: &mut Vec<(usize, f32)>
 ));
 
+#[cfg(target_arch = "x86_64")]
+mod column_pairs;
 #[cfg(target_arch = "x86_64")]
 mod x86;
 
@@ -597,16 +604,23 @@ mod tests {
             for w in [7usize, 8, 9, 15, 16, 17, 31, 32, 33, 36, 63, 64, 65, 100, 129, 160, 424] {
                 let src = Plane::from_fn(w, taps + 3, |_, _| (rng.unit() * 255.0) as f32);
                 let mut rows = Vec::new();
-                // The whole column pass as the AVX-512 build runs it (two rows at a time).
-                let mut all = Plane::default();
-                if crate::simd::avx512_available() {
-                    filter_cols(Backend::Avx512, &src, &mut all, &even, Border::Clamp, &mut FilterScratch::default())
-                        .unwrap_or_else(|e| panic!("{e}"));
-                }
+                // The whole column pass as the AVX2 and AVX-512 builds run it (two rows at a
+                // time).
+                let whole = |b: Backend| {
+                    let mut all = Plane::default();
+                    if b.resolve() == b {
+                        filter_cols(b, &src, &mut all, &even, Border::Clamp, &mut FilterScratch::default())
+                            .unwrap_or_else(|e| panic!("{e}"));
+                    }
+                    all
+                };
+                let (all256, all) = (whole(Backend::Avx2), whole(Backend::Avx512));
                 for y in 0..src.height() {
                     vertical_taps(y, src.height(), &even, Border::Clamp, &mut rows);
                     let (mut want, mut got) = (vec![0f32; w], vec![f32::NAN; w]);
                     accumulate_rows_generic::<crate::simd::Fused>(&src, &rows, &mut want);
+                    let same = want.iter().zip(all256.row(y)).all(|(a, b)| a.to_bits() == b.to_bits());
+                    assert!(same, "column pass (256), {taps} taps, width {w}, row {y}");
                     // SAFETY: AVX2 and FMA were checked above.
                     if unsafe { x86::accumulate_rows_avx2(&src, &rows, &mut got) } {
                         assert!(taps <= 64 && w >= 8);

@@ -12,7 +12,7 @@ use std::arch::x86_64::*;
 
 /// Most taps these kernels take (the row pointers live on the stack); longer kernels
 /// use the generic code.
-const MAX_TAPS: usize = 64;
+pub(super) const MAX_TAPS: usize = 64;
 
 /// The rows' first pixels and the weights of `accumulate_rows` for `n` outputs; None where
 /// the hand-written kernels do not apply: more than [`MAX_TAPS`] rows, fewer than 8 outputs,
@@ -82,7 +82,7 @@ pub(super) unsafe fn accumulate_rows_avx2(src: &Plane<f32>, rows: &[(usize, f32)
 /// end (recomputing a few outputs, as the generic kernel does); taps dealt to four running
 /// sums in turn, the taps past the last whole four to the first, as `dot8` does.
 #[target_feature(enable = "avx2,fma")]
-unsafe fn tail_quads(ptrs: &[*const f32], wts: &[f32], o: *mut f32, mut x: usize, n: usize) {
+pub(super) unsafe fn tail_quads(ptrs: &[*const f32], wts: &[f32], o: *mut f32, mut x: usize, n: usize) {
     let quads = ptrs.len() / 4 * 4;
     // SAFETY: the caller's rows and output hold n >= 8 values; every access covers
     // [x0, x0 + 8) with x0 + 8 <= n.
@@ -356,111 +356,5 @@ unsafe fn folded_vectors<const L: usize>(
             let mask = if left >= 16 { !0u16 } else { (1u16 << left) - 1 };
             _mm512_mask_storeu_ps(o.add(x), mask, acc[j]);
         }
-    }
-}
-
-/// The whole column pass with a clamped border (`filter_cols` with [`crate::filter::Border::Clamp`])
-/// with 512-bit registers, two output rows at a time: rows `y` and `y + 1` read the same
-/// input rows but one, so each loaded vector feeds both sums, and the per-row set-up (the
-/// tap list, the row pointers) is paid once per pair. The per-output chains are those of
-/// `accumulate_rows_generic` (one chain in tap order where it has one, then the same 8-wide
-/// tail), so the results are bit-identical (tested). False (nothing written) for fewer than
-/// 8 columns or kernels of more than `MAX_TAPS - 1` taps.
-#[target_feature(enable = "avx512f,avx2,fma")]
-pub(super) unsafe fn filter_cols_clamp_avx512(src: &Plane<f32>, dst: &mut Plane<f32>, k: &[f32]) -> bool {
-    let (w, h) = src.size();
-    let n = k.len();
-    if w < 8 || n == 0 || n + 1 > MAX_TAPS || dst.size() != (w, h) || h == 0 {
-        return false;
-    }
-    let hw = (n - 1) / 2;
-    let n32 = w / 32 * 32;
-    let row = |yy: isize| src.row(yy.clamp(0, h as isize - 1) as usize).as_ptr();
-    let mut ptrs = [std::ptr::null::<f32>(); MAX_TAPS];
-    let mut y = 0;
-    while y < h {
-        let pair = y + 1 < h;
-        for (t, p) in ptrs.iter_mut().enumerate().take(n + 1) {
-            *p = row(y as isize + t as isize - hw as isize);
-        }
-        let (o0, o1) = {
-            let o0 = dst.row_mut(y).as_mut_ptr();
-            let o1 = if pair { dst.row_mut(y + 1).as_mut_ptr() } else { o0 };
-            (o0, o1)
-        };
-        // SAFETY: every row holds w >= n32 values and the outputs too; x + 16 L <= n32.
-        unsafe {
-            if pair {
-                let mut x = 0;
-                while x + 80 <= n32 {
-                    pair_chunk::<5>(&ptrs[..n + 1], k, o0, o1, x);
-                    x += 80;
-                }
-                while x + 32 <= n32 {
-                    pair_chunk::<2>(&ptrs[..n + 1], k, o0, o1, x);
-                    x += 32;
-                }
-                while x + 16 <= n32 {
-                    pair_chunk::<1>(&ptrs[..n + 1], k, o0, o1, x);
-                    x += 16;
-                }
-                tail_quads(&ptrs[1..n + 1], k, o1, n32, w);
-            } else {
-                let mut x = 0;
-                while x + 16 <= n32 {
-                    one_chunk(&ptrs[..n], k, o0, x);
-                    x += 16;
-                }
-            }
-            tail_quads(&ptrs[..n], k, o0, n32, w);
-        }
-        y += if pair { 2 } else { 1 };
-    }
-    true
-}
-
-/// `L` vectors of 16 outputs of two consecutive output rows: `a` sums `k[t] r[t]` for
-/// t < n, `b` sums `k[t - 1] r[t]` for 1 <= t <= n (`ptrs` holds the n + 1 rows).
-#[inline(always)]
-unsafe fn pair_chunk<const L: usize>(ptrs: &[*const f32], k: &[f32], o0: *mut f32, o1: *mut f32, x: usize) {
-    let n = k.len();
-    // SAFETY: the caller keeps x + 16 L within every row and both outputs.
-    unsafe {
-        let mut a = [_mm512_setzero_ps(); L];
-        let mut b = [_mm512_setzero_ps(); L];
-        let first = _mm512_set1_ps(k[0]);
-        for (j, a) in a.iter_mut().enumerate() {
-            *a = _mm512_fmadd_ps(first, _mm512_loadu_ps(ptrs[0].add(x + 16 * j)), *a);
-        }
-        for t in 1..n {
-            let (wa, wb) = (_mm512_set1_ps(k[t]), _mm512_set1_ps(k[t - 1]));
-            let p = ptrs[t];
-            for j in 0..L {
-                let v = _mm512_loadu_ps(p.add(x + 16 * j));
-                a[j] = _mm512_fmadd_ps(wa, v, a[j]);
-                b[j] = _mm512_fmadd_ps(wb, v, b[j]);
-            }
-        }
-        let last = _mm512_set1_ps(k[n - 1]);
-        for (j, b) in b.iter_mut().enumerate() {
-            *b = _mm512_fmadd_ps(last, _mm512_loadu_ps(ptrs[n].add(x + 16 * j)), *b);
-        }
-        for j in 0..L {
-            _mm512_storeu_ps(o0.add(x + 16 * j), a[j]);
-            _mm512_storeu_ps(o1.add(x + 16 * j), b[j]);
-        }
-    }
-}
-
-/// One vector of 16 outputs of one row: `sum_t k[t] r[t]`, one chain.
-#[inline(always)]
-unsafe fn one_chunk(ptrs: &[*const f32], k: &[f32], o: *mut f32, x: usize) {
-    // SAFETY: the caller keeps x + 16 within every row and the output.
-    unsafe {
-        let mut a = _mm512_setzero_ps();
-        for (&p, &w) in ptrs.iter().zip(k) {
-            a = _mm512_fmadd_ps(_mm512_set1_ps(w), _mm512_loadu_ps(p.add(x)), a);
-        }
-        _mm512_storeu_ps(o.add(x), a);
     }
 }
