@@ -352,7 +352,7 @@ fn filter_rows_generic<M: Madd>(
 
 /// One padded row through `kx` (of symmetry `sym`): the hand-written kernel where it applies.
 #[inline(always)]
-pub(crate) fn correlate_row<M: Madd>(padded: &[f32], kx: &[f32], sym: Symmetry, out: &mut [f32]) {
+fn correlate_row<M: Madd>(padded: &[f32], kx: &[f32], sym: Symmetry, out: &mut [f32]) {
     #[cfg(target_arch = "x86_64")]
     if M::AVX2 && sym != Symmetry::None {
         // SAFETY: as in `filter_cols_generic`.

@@ -194,3 +194,135 @@ unsafe fn col_block<const P: usize>(tmp: *const f32, stride: usize, taps: &[(usi
         }
     }
 }
+
+/// [`preserving_lanes_avx512`] with 256-bit registers, one pixel of eight maps each: the
+/// same aligned buffers, so that no load of either pass straddles a cache line (with the
+/// generic kernel's buffers every other one did). Bit-identical to the generic kernel with
+/// [`crate::simd::Fused`] (tested).
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA.
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn preserving_lanes_avx2(
+    k: &[f32],
+    rows: &[Vec<(usize, f32)>],
+    s: &mut WideScratch,
+    src: &Plane<Lanes>,
+    dst: &mut Plane<Lanes>,
+) -> bool {
+    let (w, h) = src.size();
+    let hw = k.len().saturating_sub(1) / 2;
+    let wp = w + (w & 1);
+    let npair = wp / 2;
+    let fits = w >= 1
+        && !k.is_empty()
+        && s.off >= hw
+        && s.even.len() > (wp + hw + s.off + 2).div_ceil(2)
+        && s.tmp.len() >= h * npair
+        && s.fx_pairs.len() >= npair
+        && rows.len() >= h
+        && dst.size() == (w, h)
+        && rows.iter().take(h).all(|r| r.iter().all(|&(ry, _)| ry < h));
+    if !fits {
+        return false;
+    }
+    let first = s.off - hw;
+    let (step, wide) = if w >= 8 { (8, true) } else { (1, false) };
+    for y in 0..h {
+        // SAFETY: off + w <= 2 even.len() pixels (checked above).
+        unsafe {
+            let e = s.even.as_mut_ptr() as *mut f32;
+            std::ptr::copy_nonoverlapping(src.row(y).as_ptr() as *const f32, e.add(s.off * 8), w * 8);
+        }
+        let e = s.even.as_ptr() as *const f32;
+        let fx = s.fx_pairs.as_ptr() as *const f32;
+        let out = s.tmp[y * npair..].as_mut_ptr() as *mut f32;
+        let mut x = 0;
+        while x < w {
+            let x0 = if x + step <= w { x } else { w - step };
+            // SAFETY: pixels x0 .. x0 + step lie within the row, the padded pixels they read
+            // within `even` and the outputs within the row's pairs of `tmp`.
+            unsafe {
+                if wide {
+                    pixel_row_block::<8>(e, first, k, fx, out, x0)
+                } else {
+                    pixel_row_block::<1>(e, first, k, fx, out, x0)
+                }
+            }
+            x = x0 + step;
+        }
+    }
+    let tmp = s.tmp.as_ptr() as *const f32;
+    for (y, r) in rows.iter().enumerate().take(h) {
+        let out = dst.row_mut(y).as_mut_ptr() as *mut f32;
+        let mut x = 0;
+        while x < w {
+            let x0 = if x + step <= w { x } else { w - step };
+            // SAFETY: every tap's row is below h (checked above) and x0 + step <= w.
+            unsafe {
+                if wide {
+                    pixel_col_block::<8>(tmp, npair * 16, r, out, x0)
+                } else {
+                    pixel_col_block::<1>(tmp, npair * 16, r, out, x0)
+                }
+            }
+            x = x0 + step;
+        }
+    }
+    true
+}
+
+/// `P` pixels of the horizontal pass from pixel `x0` with 256-bit registers:
+/// `fx[x] sum_t k[t] p[x + t]`, padded pixel `i` at `e + 8 (i + first)`; the factor of
+/// pixel x is float `8 x` of the factor pairs (see [`WideScratch::new`]).
+#[inline(always)]
+unsafe fn pixel_row_block<const P: usize>(
+    e: *const f32,
+    first: usize,
+    k: &[f32],
+    fx: *const f32,
+    out: *mut f32,
+    x0: usize,
+) {
+    // SAFETY: the caller keeps every pixel read and written inside the buffers.
+    unsafe {
+        let mut a = [_mm256_setzero_ps(); P];
+        for (t, &kt) in k.iter().enumerate() {
+            let wv = _mm256_set1_ps(kt);
+            let base = e.add((x0 + t + first) * 8);
+            for (j, a) in a.iter_mut().enumerate() {
+                *a = _mm256_fmadd_ps(wv, _mm256_load_ps(base.add(8 * j)), *a);
+            }
+        }
+        for (j, a) in a.iter().enumerate() {
+            let x = x0 + j;
+            _mm256_store_ps(out.add(8 * x), _mm256_mul_ps(*a, _mm256_load_ps(fx.add(8 * x))));
+        }
+    }
+}
+
+/// `P` pixels of the vertical pass from pixel `x0` with 256-bit registers:
+/// `sum_i w_i tmp[r_i][x]`, rows of `tmp` `stride` floats apart.
+#[inline(always)]
+unsafe fn pixel_col_block<const P: usize>(
+    tmp: *const f32,
+    stride: usize,
+    taps: &[(usize, f32)],
+    out: *mut f32,
+    x0: usize,
+) {
+    // SAFETY: the caller keeps [x0, x0 + P) within the rows and every r_i < height.
+    unsafe {
+        let mut a = [_mm256_setzero_ps(); P];
+        for &(r, wt) in taps {
+            let s = tmp.add(r * stride + x0 * 8);
+            let wv = _mm256_set1_ps(wt);
+            for (j, a) in a.iter_mut().enumerate() {
+                *a = _mm256_fmadd_ps(wv, _mm256_load_ps(s.add(8 * j)), *a);
+            }
+        }
+        for (j, a) in a.iter().enumerate() {
+            _mm256_storeu_ps(out.add((x0 + j) * 8), *a);
+        }
+    }
+}
