@@ -42,6 +42,42 @@ impl WideScratch {
     }
 }
 
+impl WideScratch {
+    /// True when these buffers fit `src` (`w` x `h`), the kernel `k` and the vertical taps
+    /// `rows` (every row below h), `dst` being `src`'s size: the checks that make the
+    /// kernels' pointer arithmetic safe.
+    fn fits(&self, k: &[f32], rows: &[Vec<(usize, f32)>], src: &Plane<Lanes>, dst: &Plane<Lanes>) -> bool {
+        let (w, h) = src.size();
+        let hw = k.len().saturating_sub(1) / 2;
+        let wp = w + (w & 1);
+        w >= 1
+            && !k.is_empty()
+            && self.off >= hw
+            && self.even.len() > (wp + hw + self.off + 2).div_ceil(2)
+            && self.tmp.len() >= h * wp / 2
+            && self.fx_pairs.len() >= wp / 2
+            && rows.len() >= h
+            && dst.size() == (w, h)
+            && rows.iter().take(h).all(|r| r.iter().all(|&(ry, _)| ry < h))
+    }
+
+    /// Copies one row of the maps into the padded row (`even`), pixel x at `x + off`;
+    /// everything else stays zero. Ignores a row longer than the buffer (never, after
+    /// [`Self::fits`]).
+    fn load_row(&mut self, row: &[Lanes]) {
+        let n = row.len() * 8;
+        if (self.off + row.len()) * 8 > self.even.len() * 16 {
+            return;
+        }
+        // SAFETY: the destination holds `off * 8 + n` floats (checked just above); Pair is
+        // plain `[f32; 16]`, so its floats are contiguous.
+        unsafe {
+            let e = self.even.as_mut_ptr() as *mut f32;
+            std::ptr::copy_nonoverlapping(row.as_ptr() as *const f32, e.add(self.off * 8), n);
+        }
+    }
+}
+
 /// The energy-preserving filter of eight interleaved maps, as `preserving_lanes_generic`:
 /// the horizontal pass of each row (zero border, scaled by `fx`), then the vertical pass
 /// through `rows` (weights already scaled) into `dst`. False (nothing written) where the
@@ -62,26 +98,14 @@ pub(super) unsafe fn preserving_lanes_avx512(
     let hw = k.len().saturating_sub(1) / 2;
     let wp = w + (w & 1);
     let npair = wp / 2;
-    let fits = w >= 2
-        && !k.is_empty()
-        && s.off >= hw
-        && s.even.len() > (wp + hw + s.off + 2).div_ceil(2)
-        && s.odd.len() + 1 == s.even.len()
-        && s.tmp.len() >= h * npair
-        && s.fx_pairs.len() >= npair
-        && rows.len() >= h
-        && dst.size() == (w, h)
-        && rows.iter().take(h).all(|r| r.iter().all(|&(ry, _)| ry < h));
-    if !fits {
+    if w < 2 || s.odd.len() + 1 != s.even.len() || !s.fits(k, rows, src, dst) {
         return false;
     }
     let first = s.off - hw;
     for y in 0..h {
-        // The padded row: pixel x at x + off; everything else stays zero.
-        // SAFETY: off + w <= 2 even.len() pixels (checked above).
+        s.load_row(src.row(y));
+        // SAFETY: the pairs read and written lie in `even` and `odd` (checked above).
         unsafe {
-            let e = s.even.as_mut_ptr() as *mut f32;
-            std::ptr::copy_nonoverlapping(src.row(y).as_ptr() as *const f32, e.add(s.off * 8), w * 8);
             let e = s.even.as_ptr() as *const __m512;
             // Pixels (2q + 1, 2q + 2): the high half of pair q, the low half of pair q + 1.
             for (q, o) in s.odd.iter_mut().enumerate() {
@@ -214,26 +238,13 @@ pub(super) unsafe fn preserving_lanes_avx2(
     let hw = k.len().saturating_sub(1) / 2;
     let wp = w + (w & 1);
     let npair = wp / 2;
-    let fits = w >= 1
-        && !k.is_empty()
-        && s.off >= hw
-        && s.even.len() > (wp + hw + s.off + 2).div_ceil(2)
-        && s.tmp.len() >= h * npair
-        && s.fx_pairs.len() >= npair
-        && rows.len() >= h
-        && dst.size() == (w, h)
-        && rows.iter().take(h).all(|r| r.iter().all(|&(ry, _)| ry < h));
-    if !fits {
+    if !s.fits(k, rows, src, dst) {
         return false;
     }
     let first = s.off - hw;
     let (step, wide) = if w >= 8 { (8, true) } else { (1, false) };
     for y in 0..h {
-        // SAFETY: off + w <= 2 even.len() pixels (checked above).
-        unsafe {
-            let e = s.even.as_mut_ptr() as *mut f32;
-            std::ptr::copy_nonoverlapping(src.row(y).as_ptr() as *const f32, e.add(s.off * 8), w * 8);
-        }
+        s.load_row(src.row(y));
         let e = s.even.as_ptr() as *const f32;
         let fx = s.fx_pairs.as_ptr() as *const f32;
         let out = s.tmp[y * npair..].as_mut_ptr() as *mut f32;
