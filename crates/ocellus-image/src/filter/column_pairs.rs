@@ -47,6 +47,16 @@ macro_rules! column_pairs {
                             pair_chunk::<$big>(&ptrs[..n + 1], k, o0, o1, x);
                             x += $big * $lanes;
                         }
+                        // What is left in as few chunks as possible: one register per
+                        // row is only two chains, too few to hide the latency.
+                        if x + 4 * $lanes <= n32 {
+                            pair_chunk::<4>(&ptrs[..n + 1], k, o0, o1, x);
+                            x += 4 * $lanes;
+                        }
+                        if x + 2 * $lanes <= n32 {
+                            pair_chunk::<2>(&ptrs[..n + 1], k, o0, o1, x);
+                            x += 2 * $lanes;
+                        }
                         while x + $lanes <= n32 {
                             pair_chunk::<1>(&ptrs[..n + 1], k, o0, o1, x);
                             x += $lanes;

@@ -273,6 +273,10 @@ pub(super) unsafe fn correlate_folded_avx512(buf: &[f32], start: usize, k: &[f32
             folded_vectors::<4>(c, o, v, n, &w, h, odd);
             v += 4;
         }
+        if v + 2 <= nv {
+            folded_vectors::<2>(c, o, v, n, &w, h, odd);
+            v += 2;
+        }
         while v < nv {
             folded_vectors::<1>(c, o, v, n, &w, h, odd);
             v += 1;
