@@ -318,15 +318,12 @@ fn rows_pass<M: Madd, T: Copy + Default + Into<f32>>(
         padded.resize(w + 2 * hwx + 96, 0.0);
         let first = padded.as_ptr() as usize / 4 + hwx;
         let start = 16 + (16 - first % 16) % 16;
-        let aligned = (padded.as_ptr() as usize).is_multiple_of(4);
         for y in y0..y1 {
             pad_into(&src.row(y)[x0..x1], hwx, border, &mut padded[start..start + w + 2 * hwx]);
             // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512, which
             // `dispatch_kernel!` calls only on CPUs that have it.
-            let done = aligned
-                && unsafe {
-                    x86::correlate_folded_avx512(padded, start, kx, sym == Symmetry::Odd, dst.row_mut(y - y0))
-                };
+            let done =
+                unsafe { x86::correlate_folded_avx512(padded, start, kx, sym == Symmetry::Odd, dst.row_mut(y - y0)) };
             if !done {
                 correlate_row::<M>(&padded[start..start + w + 2 * hwx], kx, sym, dst.row_mut(y - y0));
             }
@@ -615,6 +612,14 @@ mod tests {
                     all
                 };
                 let (all256, all) = (whole(Backend::Avx2), whole(Backend::Avx512));
+                // The same rows at a stride that is not a multiple of 16 floats: each row starts
+                // at another offset within a cache line.
+                let mut strided = vec![0f32; (w + 3) * src.height()];
+                for y in 0..src.height() {
+                    strided[y * (w + 3)..y * (w + 3) + w].copy_from_slice(src.row(y));
+                }
+                let sub =
+                    Plane::from_vec_with_stride(w, src.height(), w + 3, strided).unwrap_or_else(|e| panic!("{e}"));
                 for y in 0..src.height() {
                     vertical_taps(y, src.height(), &even, Border::Clamp, &mut rows);
                     let (mut want, mut got) = (vec![0f32; w], vec![f32::NAN; w]);
@@ -632,16 +637,6 @@ mod tests {
                     if crate::simd::avx512_available() {
                         let same = want.iter().zip(all.row(y)).all(|(a, b)| a.to_bits() == b.to_bits());
                         assert!(same, "column pass (512), {taps} taps, width {w}, row {y}");
-                        // Rows starting at every offset within a cache line: a stride that is
-                        // not a multiple of 16 floats moves each row's start.
-                        let sub = Plane::from_vec_with_stride(w, src.height(), w + 3, {
-                            let mut v = vec![0f32; (w + 3) * src.height()];
-                            for y in 0..src.height() {
-                                v[y * (w + 3)..y * (w + 3) + w].copy_from_slice(src.row(y));
-                            }
-                            v
-                        })
-                        .unwrap_or_else(|e| panic!("{e}"));
                         for (name, plane) in [("aligned", &src), ("strided", &sub)] {
                             let mut got = vec![f32::NAN; w];
                             // SAFETY: AVX-512 was checked just above.

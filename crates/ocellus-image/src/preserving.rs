@@ -57,10 +57,10 @@ pub struct PreservingFilter {
 #[repr(C, align(64))]
 struct Pair([f32; 16]);
 
-/// The AVX-512 lanes kernel's aligned buffers (see `preserving/x86.rs`): the padded row as
-/// pairs from even pixels (`even`, pixel x of the map at `x + off`) and from odd ones
-/// (`odd`), the horizontal pass's output (`tmp`, rows of `ceil(w / 2)` pairs) and its border
-/// factors in pairs. Empty off x86-64.
+/// The hand-written lanes kernels' aligned buffers (see `preserving/x86.rs`): the padded row
+/// as pairs from even pixels (`even`, pixel x of the map at `x + off`) and, for the AVX-512
+/// kernel, from odd ones (`odd`), the horizontal pass's output (`tmp`, rows of `ceil(w / 2)`
+/// pairs) and its border factors in pairs. Empty off x86-64.
 #[derive(Clone, Debug, Default)]
 struct WideScratch {
     off: usize,
@@ -186,7 +186,7 @@ fn preserving_lanes_generic<M: Madd>(
         }
     }
     #[cfg(target_arch = "x86_64")]
-    if M::AVX2 && !M::AVX512 {
+    if M::AVX2 {
         // SAFETY: `M::AVX2` is true only inside kernels compiled for AVX2 and FMA, which
         // `dispatch_kernel!` calls only on CPUs that have both.
         if unsafe { x86::preserving_lanes_avx2(k, rows, wide, src, dst) } {
@@ -326,6 +326,7 @@ mod tests {
                 let f = PreservingFilter::new(&k, w, h).unwrap_or_else(|e| panic!("{e}"));
                 let (mut pad, mut tmp) = (f.padded_lanes.clone(), Plane::default());
                 let mut want = Plane::new(w, h);
+                // Empty buffers: the hand-written kernels refuse them, so this is the generic loop.
                 let mut unused = WideScratch::default();
                 preserving_lanes_generic::<crate::simd::Fused>(
                     &k,

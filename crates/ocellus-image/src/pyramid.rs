@@ -337,7 +337,6 @@ fn pyr_down_rgb8_generic<M: Madd>(
 ) {
     let (w, h) = src.size();
     let [d0, d1, d2] = dst;
-    s.row3.resize(3 * w, 0.0);
     for c in 0..3 {
         s.even3[c].resize(w.div_ceil(2), 0.0);
         s.odd3[c].resize(w / 2, 0.0);
@@ -345,55 +344,58 @@ fn pyr_down_rgb8_generic<M: Madd>(
     let integer = kernel.integer_taps();
     if integer.is_some() {
         s.row16.resize(3 * w, 0);
+    } else {
+        s.row3.resize(3 * w, 0.0);
     }
     for j in 0..d0.height() {
         let [e0, e1, e2] = &mut s.even3;
         let [o0, o1, o2] = &mut s.odd3;
-        // Plain slices: indexing a Vec inside the loop would reload its header every time.
-        let half = w / 2;
-        let (e0, e1, e2): (&mut [f32], &mut [f32], &mut [f32]) = (&mut e0[..], &mut e1[..], &mut e2[..]);
-        let (o0, o1, o2) = (&mut o0[..half], &mut o1[..half], &mut o2[..half]);
+        let (e0, e1, e2): (&mut [f32], &mut [f32], &mut [f32]) = (e0, e1, e2);
+        let (o0, o1, o2): (&mut [f32], &mut [f32], &mut [f32]) = (o0, o1, o2);
         if let Some(ik) = &integer {
             // Exact integer sums of bytes (see `IntegerTaps`), then one scaling to [0, 1] as
             // the samples are split into even/odd per channel.
-            let d = ik.taps_for(j, h, &mut s.itaps);
+            let d = ik.taps_for(kernel, j, h, &mut s.taps, &mut s.itaps);
             vertical_bytes_u16(src, &s.itaps, &mut s.row16);
-            let scale = 1.0 / (d as f32 * 255.0);
-            for (k, px) in s.row16.chunks_exact(6).take(half).enumerate() {
-                e0[k] = px[0] as f32 * scale;
-                e1[k] = px[1] as f32 * scale;
-                e2[k] = px[2] as f32 * scale;
-                o0[k] = px[3] as f32 * scale;
-                o1[k] = px[4] as f32 * scale;
-                o2[k] = px[5] as f32 * scale;
-            }
-            if w % 2 == 1 {
-                let last = &s.row16[3 * (w - 1)..];
-                e0[w / 2] = last[0] as f32 * scale;
-                e1[w / 2] = last[1] as f32 * scale;
-                e2[w / 2] = last[2] as f32 * scale;
-            }
+            split_even_odd(&s.row16, 1.0 / (d as f32 * 255.0), [e0, e1, e2], [o0, o1, o2]);
         } else {
             vertical_bytes::<M>(src, j, h, kernel, &mut s.taps, &mut s.row3);
-            // Split into even/odd samples per channel (two RGB pixels = 6 values at a time).
-            for (k, px) in s.row3.chunks_exact(6).take(half).enumerate() {
-                e0[k] = px[0];
-                e1[k] = px[1];
-                e2[k] = px[2];
-                o0[k] = px[3];
-                o1[k] = px[4];
-                o2[k] = px[5];
-            }
-            if w % 2 == 1 {
-                let last = &s.row3[3 * (w - 1)..];
-                e0[w / 2] = last[0];
-                e1[w / 2] = last[1];
-                e2[w / 2] = last[2];
-            }
+            // Scaling by 1 is exact: the same values as a plain split.
+            split_even_odd(&s.row3, 1.0, [e0, e1, e2], [o0, o1, o2]);
         }
         for (c, d) in [&mut *d0, &mut *d1, &mut *d2].into_iter().enumerate() {
             decimate_one::<M>(&s.even3[c], &s.odd3[c], w, kernel, &mut s.taps2, d.row_mut(j));
         }
+    }
+}
+
+/// Splits an interleaved RGB row into even- and odd-indexed samples per channel (two RGB
+/// pixels = 6 values at a time), each scaled by `scale`.
+#[inline(always)]
+fn split_even_odd<T: Copy + Into<f32>>(row: &[T], scale: f32, even: [&mut [f32]; 3], odd: [&mut [f32]; 3]) {
+    let w = row.len() / 3;
+    let half = w / 2;
+    if even.iter().any(|e| e.len() < w.div_ceil(2)) || odd.iter().any(|o| o.len() < half) {
+        return;
+    }
+    let [e0, e1, e2] = even;
+    let [o0, o1, o2] = odd;
+    // Slices of exactly `half` values: the loop then needs no bounds tests and vectorizes.
+    let (f0, f1, f2) = (&mut e0[..half], &mut e1[..half], &mut e2[..half]);
+    let (o0, o1, o2) = (&mut o0[..half], &mut o1[..half], &mut o2[..half]);
+    for (k, px) in row.chunks_exact(6).take(half).enumerate() {
+        f0[k] = px[0].into() * scale;
+        f1[k] = px[1].into() * scale;
+        f2[k] = px[2].into() * scale;
+        o0[k] = px[3].into() * scale;
+        o1[k] = px[4].into() * scale;
+        o2[k] = px[5].into() * scale;
+    }
+    if w % 2 == 1 {
+        let last = &row[3 * (w - 1)..];
+        e0[w / 2] = last[0].into() * scale;
+        e1[w / 2] = last[1].into() * scale;
+        e2[w / 2] = last[2].into() * scale;
     }
 }
 
@@ -404,9 +406,6 @@ fn pyr_down_rgb8_generic<M: Madd>(
 #[derive(Clone, Copy, Debug)]
 struct IntegerTaps {
     n: [u16; MAX_TAPS],
-    len: usize,
-    origin: usize,
-    stb_size3_rule: bool,
 }
 
 impl PyramidKernel {
@@ -420,27 +419,33 @@ impl PyramidKernel {
             (exact && sum == d as f32 && taps.len() == self.taps.len()).then(|| {
                 let mut n = [0u16; MAX_TAPS];
                 n.iter_mut().zip(taps).for_each(|(o, t)| *o = (t * d as f32).round() as u16);
-                IntegerTaps { n, len: taps.len(), origin: self.origin, stb_size3_rule: self.stb_size3_rule }
+                IntegerTaps { n }
             })
         })
     }
 }
 
 impl IntegerTaps {
-    /// The taps of output `j` of a dimension of `n` samples (those inside it, as
-    /// [`PyramidKernel::taps_for`]), into `out`; returns their sum, the divisor of the output.
-    fn taps_for(&self, j: usize, n: usize, out: &mut Vec<(usize, u16)>) -> u32 {
+    /// The taps of output `j` of a dimension of `n` samples: those `kernel.taps_for` keeps
+    /// (its border rule, written once), with their integer weights, into `out` (`ftaps` is
+    /// scratch); returns their sum, the divisor of the output.
+    fn taps_for(
+        &self,
+        kernel: &PyramidKernel,
+        j: usize,
+        n: usize,
+        ftaps: &mut Vec<(usize, f32)>,
+        out: &mut Vec<(usize, u16)>,
+    ) -> u32 {
         out.clear();
-        if self.stb_size3_rule && n == 3 {
+        if kernel.stb_size3_rule && n == 3 {
+            // The toolbox's [1 2 1] / 4 for three samples, as `taps_for` has it.
             out.extend_from_slice(&[(0, 1), (1, 2), (2, 1)]);
             return 4;
         }
-        for (t, &k) in self.n[..self.len].iter().enumerate() {
-            let i = (2 * j + t) as isize - self.origin as isize;
-            if i >= 0 && (i as usize) < n && k > 0 {
-                out.push((i as usize, k));
-            }
-        }
+        kernel.taps_for(j, n, ftaps);
+        // Input i of output j is tap t = i + origin - 2 j.
+        out.extend(ftaps.iter().map(|&(i, _)| (i, self.n[i + kernel.origin - 2 * j])).filter(|&(_, k)| k > 0));
         out.iter().map(|&(_, k)| k as u32).sum::<u32>().max(1)
     }
 }

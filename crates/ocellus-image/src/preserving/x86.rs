@@ -1,4 +1,5 @@
-//! Hand-written AVX-512 kernel of the energy-preserving filter on eight interleaved maps.
+//! Hand-written AVX-512 and AVX2 kernels of the energy-preserving filter on eight
+//! interleaved maps.
 //!
 //! Why by hand: the generic kernel keeps a pixel's eight lanes in an `[f32; 8]`, which LLVM
 //! maps onto 256-bit registers even inside the AVX-512 build. On a core with full-width
@@ -8,7 +9,8 @@
 //! an odd pixel splits in two, and with every load split the kernel was no faster than the
 //! 256-bit one. So the padded row is kept twice in 64-byte aligned pairs, starting at even
 //! and at odd pixels, and the horizontal pass's output in aligned pairs too; every load of
-//! the two passes is then one cache line.
+//! the two passes is then one cache line. The AVX2 kernel reads the same buffers one pixel
+//! (32 bytes) at a time, so none of its loads straddles a line either.
 //!
 //! Each output lane is the same chain of fused multiply-adds, in the same tap order, as the
 //! generic kernel with [`crate::simd::Fused`], so the results are bit-identical (tested).
@@ -40,17 +42,22 @@ impl WideScratch {
             fx_pairs,
         }
     }
-}
 
-impl WideScratch {
-    /// True when these buffers fit `src` (`w` x `h`), the kernel `k` and the vertical taps
-    /// `rows` (every row below h), `dst` being `src`'s size: the checks that make the
-    /// kernels' pointer arithmetic safe.
-    fn fits(&self, k: &[f32], rows: &[Vec<(usize, f32)>], src: &Plane<Lanes>, dst: &Plane<Lanes>) -> bool {
+    /// `Some((first, npair))` when these buffers fit `src` (`w` x `h`), the kernel `k` and the vertical taps
+    /// `rows` (every row below h), `dst` being `src`'s size (the checks that make the
+    /// kernels' pointer arithmetic safe): `first` is the padded pixel that tap 0 of output 0
+    /// reads, `npair` the pairs per row of `tmp`.
+    fn fits(
+        &self,
+        k: &[f32],
+        rows: &[Vec<(usize, f32)>],
+        src: &Plane<Lanes>,
+        dst: &Plane<Lanes>,
+    ) -> Option<(usize, usize)> {
         let (w, h) = src.size();
         let hw = k.len().saturating_sub(1) / 2;
         let wp = w + (w & 1);
-        w >= 1
+        let fits = w >= 1
             && !k.is_empty()
             && self.off >= hw
             && self.even.len() > (wp + hw + self.off + 2).div_ceil(2)
@@ -58,7 +65,8 @@ impl WideScratch {
             && self.fx_pairs.len() >= wp / 2
             && rows.len() >= h
             && dst.size() == (w, h)
-            && rows.iter().take(h).all(|r| r.iter().all(|&(ry, _)| ry < h))
+            && rows.iter().take(h).all(|r| r.iter().all(|&(ry, _)| ry < h));
+        fits.then(|| (self.off - hw, wp / 2))
     }
 
     /// Copies one row of the maps into the padded row (`even`), pixel x at `x + off`;
@@ -95,13 +103,11 @@ pub(super) unsafe fn preserving_lanes_avx512(
     dst: &mut Plane<Lanes>,
 ) -> bool {
     let (w, h) = src.size();
-    let hw = k.len().saturating_sub(1) / 2;
-    let wp = w + (w & 1);
-    let npair = wp / 2;
-    if w < 2 || s.odd.len() + 1 != s.even.len() || !s.fits(k, rows, src, dst) {
+    let Some((first, npair)) = s.fits(k, rows, src, dst) else { return false };
+    if w < 2 || s.odd.len() + 1 != s.even.len() {
         return false;
     }
-    let first = s.off - hw;
+    let wp = 2 * npair;
     for y in 0..h {
         s.load_row(src.row(y));
         // SAFETY: the pairs read and written lie in `even` and `odd` (checked above).
@@ -235,13 +241,7 @@ pub(super) unsafe fn preserving_lanes_avx2(
     dst: &mut Plane<Lanes>,
 ) -> bool {
     let (w, h) = src.size();
-    let hw = k.len().saturating_sub(1) / 2;
-    let wp = w + (w & 1);
-    let npair = wp / 2;
-    if !s.fits(k, rows, src, dst) {
-        return false;
-    }
-    let first = s.off - hw;
+    let Some((first, npair)) = s.fits(k, rows, src, dst) else { return false };
     let (step, wide) = if w >= 8 { (8, true) } else { (1, false) };
     for y in 0..h {
         s.load_row(src.row(y));
