@@ -63,6 +63,10 @@ pub struct OdometryArgs {
     /// `--gain-field false` keeps one global gain.
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
     gain_field: bool,
+    /// Robust mode: sigma of the Gaussian both frames are smoothed by before Lucas-Kanade,
+    /// pixels (below 0.3: not smoothed). Range: 0..=5.
+    #[arg(long, default_value_t = ocellus_odometry::lucas_kanade::DEFAULT_SMOOTH_SIGMA_PX, value_parser = ranges::within(0.0f32, 5.0))]
+    smooth_sigma_px: f32,
     /// Frame rate, Hz (timestamps of the trajectory). Range: above 0, at most 1000000.
     #[arg(long, default_value_t = 200.0, value_parser = ranges::above(0.0f64, 1e6))]
     rate_hz: f64,
@@ -141,6 +145,7 @@ pub fn run(a: OdometryArgs) -> Result<()> {
     cfg.robust.height_pull = a.height_pull;
     cfg.robust.height_noise_frames = a.height_noise_frames;
     cfg.robust.gain_field = a.gain_field;
+    cfg.robust.smooth_sigma_px = a.smooth_sigma_px;
     let mut vo = VisualOdometry::new(cfg)?;
     let readings: Option<Vec<EncoderReading>> = match &a.encoders {
         Some(p) => {
