@@ -63,7 +63,10 @@ pub struct SmoothedFrame {
 impl SmoothedFrame {
     /// Smooths `rect` = `[x0, y0, x1, y1]` (frame pixels, end exclusive) of `frame` by a
     /// Gaussian of `sigma_px` ([`ocellus_image::filter::gaussian_blur`]'s kernel; below 0.3 px:
-    /// converted only).
+    /// not smoothed) and makes the cubic B-spline through the result: its coefficients
+    /// ([`Self::coeffs`], by [`spline_kernel`]) and its values at the pixels ([`Self::plane`],
+    /// within 2e-3 grey levels of the Gaussian alone inside the frame; at the frame's edge the
+    /// spline clamps its coefficients rather than the pixels).
     pub fn update(&mut self, backend: Backend, frame: &Plane<u8>, sigma_px: f32, rect: [usize; 4]) -> Result<()> {
         let (w, h) = frame.size();
         let [x0, y0, x1, y1] = rect;
