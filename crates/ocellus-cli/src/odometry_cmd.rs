@@ -65,7 +65,7 @@ pub struct OdometryArgs {
     gain_field: bool,
     /// Robust mode: sigma of the Gaussian both frames are smoothed by before Lucas-Kanade,
     /// pixels (below 0.3: not smoothed). Range: 0..=5.
-    #[arg(long, default_value_t = ocellus_odometry::lucas_kanade::DEFAULT_SMOOTH_SIGMA_PX, value_parser = ranges::within(0.0f32, 5.0))]
+    #[arg(long, default_value_t = ocellus_odometry::spline::DEFAULT_SMOOTH_SIGMA_PX, value_parser = ranges::within(0.0f32, 5.0))]
     smooth_sigma_px: f32,
     /// Frame rate, Hz (timestamps of the trajectory). Range: above 0, at most 1000000.
     #[arg(long, default_value_t = 200.0, value_parser = ranges::above(0.0f64, 1e6))]

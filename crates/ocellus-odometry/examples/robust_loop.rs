@@ -2,7 +2,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 use ocellus_image::Plane;
 use ocellus_odometry::kinematics::Mount;
-use ocellus_odometry::lucas_kanade::SmoothedFrame;
+use ocellus_odometry::spline::SmoothedFrame;
 use ocellus_odometry::vo::{OdometryConfig, VisualOdometry};
 use ocellus_synth::ground::{GroundConfig, GroundScene, GroundTexture};
 

@@ -30,6 +30,7 @@ pub mod kinematics;
 pub mod lucas_kanade;
 pub mod robust;
 pub mod sad_flow;
+pub mod spline;
 pub mod vo;
 
 use thiserror::Error;

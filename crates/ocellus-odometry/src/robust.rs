@@ -23,8 +23,9 @@
 //! frame n-1 is seen at `u' = (u - r) cos w + (v + f) sin w`, `v' = -(u - r) sin w + (v + f) cos w`.
 
 use crate::gain_field::GainField;
-use crate::lucas_kanade::{lk_sums, lk_sums_gain, sums_at_gain, SmoothedFrame, DEFAULT_SMOOTH_SIGMA_PX};
+use crate::lucas_kanade::{lk_sums, lk_sums_gain, sums_at_gain};
 use crate::sad_flow::{window_flows, SadFlowConfig};
+use crate::spline::{SmoothedFrame, DEFAULT_SMOOTH_SIGMA_PX};
 use crate::{OdometryError, Result};
 use nalgebra::{Matrix3, Matrix4, Vector3, Vector4};
 use ocellus_image::Plane;
@@ -206,7 +207,7 @@ fn region_mean(img: &Plane<u8>, region: usize) -> f64 {
 /// The rectangle `[x0, y0, x1, y1]` (end exclusive) of a `w` x `h` frame that Lucas-Kanade
 /// reads with `cfg`: the searched region, grown by what the support adds beyond the block and
 /// by the largest flow's reach (the search margin, one Lucas-Kanade pixel, the patch border
-/// and bilinear neighbour; worked out in a comment inside). Errors as the search does for a
+/// and the spline's neighbours; worked out in a comment inside). Errors as the search does for a
 /// frame smaller than the region or a bad configuration.
 pub fn lk_rect(w: usize, h: usize, cfg: &RobustConfig) -> Result<[usize; 4]> {
     cfg.check()?;

@@ -13,9 +13,9 @@
 //! robot's motion follows with the mount offset ([`crate::kinematics::robot_motion`]).
 
 use crate::kinematics::{moved_by_camera, robot_motion, Mount, Pose2};
-use crate::lucas_kanade::SmoothedFrame;
 use crate::robust::{fit_rigid, lk_rect, window_measurements_smoothed, RobustConfig};
 use crate::sad_flow::{group_flows, FlowPoint, SadFlowConfig};
+use crate::spline::SmoothedFrame;
 use crate::{OdometryError, Result};
 use nalgebra::{Matrix3, Vector3};
 use ocellus_image::Plane;
