@@ -4,12 +4,25 @@ use crate::{ImageError, Result};
 ///
 /// `T` is the pixel type: `f32` for feature maps, `u8` for grey images, `[u8; 3]` for
 /// interleaved RGB. Row `y` occupies `data[y * stride .. y * stride + width]`.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct Plane<T> {
     width: usize,
     height: usize,
     stride: usize,
     data: Vec<T>,
+}
+
+impl<T: Clone> Clone for Plane<T> {
+    fn clone(&self) -> Self {
+        Self { width: self.width, height: self.height, stride: self.stride, data: self.data.clone() }
+    }
+
+    /// Copies `source` into this plane's buffer, which is reused when it is large enough (a
+    /// stream that keeps its previous frame then allocates nothing per frame).
+    fn clone_from(&mut self, source: &Self) {
+        (self.width, self.height, self.stride) = (source.width, source.height, source.stride);
+        self.data.clone_from(&source.data);
+    }
 }
 
 impl<T: Copy + Default> Default for Plane<T> {

@@ -115,6 +115,8 @@ pub struct OdometryStep {
 pub struct VisualOdometry {
     cfg: OdometryConfig,
     prev: Option<Plane<u8>>,
+    /// The buffer the next frame is copied into (the frame before the previous one's).
+    spare: Plane<u8>,
     /// The previous frame smoothed for Lucas-Kanade (robust mode; each frame is smoothed once),
     /// when it is the previous frame's.
     prev_smooth: SmoothedFrame,
@@ -142,6 +144,7 @@ impl VisualOdometry {
         Ok(Self {
             cfg,
             prev: None,
+            spare: Plane::default(),
             prev_smooth: SmoothedFrame::default(),
             prev_smooth_valid: false,
             cur_smooth: SmoothedFrame::default(),
@@ -164,7 +167,13 @@ impl VisualOdometry {
 
     /// Processes the next frame (grey, the same size as the previous ones).
     pub fn step(&mut self, frame: &Plane<u8>) -> Result<OdometryStep> {
-        let Some(prev) = self.prev.replace(frame.clone()) else {
+        // The frame is copied first, into the buffer of the frame before the previous one:
+        // no allocation per step, and the copy reads the frame in one sequential pass, which
+        // brings it into the cache for the block search's scattered reads (copied after the
+        // step, a seed step on frames fresh from memory took 0.19 instead of 0.12 ms).
+        self.spare.clone_from(frame);
+        let Some(prev) = self.prev.take() else {
+            self.prev = Some(std::mem::take(&mut self.spare));
             return Ok(OdometryStep {
                 pose: self.pose,
                 camera_motion: [0.0; 3],
@@ -174,10 +183,13 @@ impl VisualOdometry {
                 height_m: self.cfg.height_m * self.height.ratio(),
             });
         };
-        match self.cfg.mode {
-            Mode::Robust => self.step_robust(&prev, frame),
-            Mode::Seed => self.step_seed(&prev, frame),
-        }
+        let frame = std::mem::take(&mut self.spare);
+        let step = match self.cfg.mode {
+            Mode::Robust => self.step_robust(&prev, &frame),
+            Mode::Seed => self.step_seed(&prev, &frame),
+        };
+        (self.spare, self.prev) = (prev, Some(frame));
+        step
     }
 
     /// The seed's step (SPEC 6.2-6.3) from `prev` to `frame`.
