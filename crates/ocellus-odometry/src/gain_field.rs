@@ -32,8 +32,8 @@ impl GainField {
         let mut q = Self::flat();
         // The scale of the Cauchy weights: the median of each point's standard deviation.
         let mut sd: Vec<f64> = pts.iter().map(|p| 1.0 / p[3].max(1e-300).sqrt()).collect();
-        sd.sort_by(f64::total_cmp);
-        let scale = sd[sd.len() / 2];
+        let mid = sd.len() / 2;
+        let (_, &mut scale, _) = sd.select_nth_unstable_by(mid, f64::total_cmp);
         for _ in 0..4 {
             let mut a = nalgebra::SMatrix::<f64, 6, 6>::zeros();
             let mut g = nalgebra::SVector::<f64, 6>::zeros();
@@ -41,8 +41,9 @@ impl GainField {
                 let e = (p[2] - q.at(p[0], p[1])) / scale;
                 let w = p[3] / (1.0 + e * e);
                 let phi = Self::basis(p[0], p[1]);
+                // The lower triangle only: the Cholesky factorization reads no other.
                 for r in 0..6 {
-                    for c in 0..6 {
+                    for c in 0..=r {
                         a[(r, c)] += w * phi[r] * phi[c];
                     }
                     g[r] += w * phi[r] * p[2];
