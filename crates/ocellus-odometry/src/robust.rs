@@ -213,8 +213,8 @@ fn even_sum(row: &[u8]) -> u64 {
     // Pairs, not `step_by(2)`: the same pixels and the same integer sum, but a loop the
     // compiler vectorizes (a row of fewer than 2^24 pixels of at most 255 sums within a u32).
     let (pairs, rest) = row.split_at(row.len() / 2 * 2);
-    let even: u32 = pairs.chunks_exact(2).map(|p| u32::from(p[0])).sum::<u32>()
-        + rest.iter().map(|&v| u32::from(v)).sum::<u32>();
+    let even: u32 =
+        pairs.chunks_exact(2).map(|p| u32::from(p[0])).sum::<u32>() + rest.iter().map(|&v| u32::from(v)).sum::<u32>();
     u64::from(even)
 }
 
@@ -530,6 +530,109 @@ fn predict_with(u: f64, v: f64, p: &Vector4<f64>, (s, c): (f64, f64)) -> ([f64; 
     ([m * ru, m * rv], [[-c * m, s * m, (-a * s + b * c) * m, ru], [s * m, c * m, (-a * c - b * s) * m, rv]])
 }
 
+/// The measurements of [`fit_rigid`] by component, padded with windows of weight 0 to a
+/// multiple of [`FIT_LANES`], so that the lanes of [`rigid_normal_equations`] are vectors.
+struct FitPoints {
+    /// u, v, u + du, v + dv, the information's four entries, 2 / its trace, the weight (1 or 0).
+    cols: [Vec<f64>; 10],
+}
+
+/// Windows summed side by side in [`rigid_normal_equations`]: four f64 lanes are one AVX2
+/// register.
+const FIT_LANES: usize = 4;
+
+impl FitPoints {
+    fn new(meas: &[WindowMeasurement]) -> Self {
+        let n = meas.len().div_ceil(FIT_LANES) * FIT_LANES;
+        let col = |f: &dyn Fn(&WindowMeasurement) -> f64| {
+            let mut c: Vec<f64> = meas.iter().map(f).collect();
+            c.resize(n, 0.0);
+            c
+        };
+        Self {
+            cols: [
+                col(&|m| m.u),
+                col(&|m| m.v),
+                col(&|m| m.u + m.du),
+                col(&|m| m.v + m.dv),
+                col(&|m| m.info[0][0]),
+                col(&|m| m.info[0][1]),
+                col(&|m| m.info[1][0]),
+                col(&|m| m.info[1][1]),
+                col(&|m| 1.0 / ((m.info[0][0] + m.info[1][1]).max(1e-12) * 0.5)),
+                col(&|_| 1.0),
+            ],
+        }
+    }
+
+    /// Keeps the windows marked in `keep` (the rest weigh 0).
+    fn keep(&mut self, keep: &[bool]) {
+        for (w, &k) in self.cols[9].iter_mut().zip(keep) {
+            *w = if k { 1.0 } else { 0.0 };
+        }
+    }
+}
+
+ocellus_image::dispatch_kernel!(
+    /// The normal equations of one reweighted Gauss-Newton step of [`fit_rigid`] at the motion
+    /// `p` (right, forward, turn, scale change): the upper triangle of `sum J^T W J`, row by
+    /// row, and `sum J^T W e`, with W each window's information times its Cauchy weight (scale
+    /// `cauchy_px`) on the residual's length in pixels. In [`FIT_LANES`] running sums per
+    /// entry, added at the end: the same order, and so the same result, on every backend.
+    fn rigid_normal_equations => rigid_normal_equations_generic(pts: &FitPoints, p: &[f64; 4], cauchy_px: f64) -> ([f64; 10], [f64; 4])
+);
+
+// `M` only picks the instruction set the dispatch compiles this for: the f64 sums take no
+// multiply-add flavour (separate multiplies and adds on every backend).
+#[allow(clippy::extra_unused_type_parameters)]
+#[inline(always)]
+fn rigid_normal_equations_generic<M: ocellus_image::simd::Madd>(
+    pts: &FitPoints,
+    p: &[f64; 4],
+    cauchy_px: f64,
+) -> ([f64; 10], [f64; 4]) {
+    const L: usize = FIT_LANES;
+    let [r, f, turn, k] = *p;
+    let (s, c) = turn.sin_cos();
+    let m = 1.0 + k;
+    let cc = cauchy_px * cauchy_px;
+    let mut upper = [[0.0f64; L]; 10];
+    let mut grad = [[0.0f64; L]; 4];
+    let [us, vs, tus, tvs, w00s, w01s, w10s, w11s, invs, keeps] = &pts.cols;
+    let chunks = us.len() / L;
+    let lanes = |col: &[f64], i: usize| -> [f64; L] { std::array::from_fn(|l| col[i * L + l]) };
+    for i in 0..chunks {
+        let (u, v, tu, tv) = (lanes(us, i), lanes(vs, i), lanes(tus, i), lanes(tvs, i));
+        let (w00, w01, w10, w11) = (lanes(w00s, i), lanes(w01s, i), lanes(w10s, i), lanes(w11s, i));
+        let (inv, keep) = (lanes(invs, i), lanes(keeps, i));
+        for l in 0..L {
+            // The rigid model and its derivatives (see `predict_with`).
+            let (a, b) = (u[l] - r, v[l] + f);
+            let (ru, rv) = (a * c + b * s, -a * s + b * c);
+            let j0 = [-c * m, s * m, rv * m, ru];
+            let j1 = [s * m, c * m, (-a * c - b * s) * m, rv];
+            let e = [tu[l] - m * ru, tv[l] - m * rv];
+            // Cauchy weight on the residual's Mahalanobis length in pixels.
+            let maha = (e[0] * (w00[l] * e[0] + w01[l] * e[1]) + e[1] * (w10[l] * e[0] + w11[l] * e[1])).max(0.0);
+            let rw = keep[l] / (1.0 + maha * inv[l] / cc);
+            // J^T W (4x2), then the rank-2 update of the normal matrix's upper triangle.
+            let jtw: [[f64; 2]; 4] = std::array::from_fn(|q| {
+                [rw * (j0[q] * w00[l] + j1[q] * w10[l]), rw * (j0[q] * w01[l] + j1[q] * w11[l])]
+            });
+            let mut n = 0;
+            for q in 0..4 {
+                for t in q..4 {
+                    upper[n][l] += jtw[q][0] * j0[t] + jtw[q][1] * j1[t];
+                    n += 1;
+                }
+                grad[q][l] += jtw[q][0] * e[0] + jtw[q][1] * e[1];
+            }
+        }
+    }
+    let total = |x: &[f64; L]| x.iter().sum::<f64>();
+    (upper.each_ref().map(total), grad.each_ref().map(total))
+}
+
 /// Fits the rigid motion to the measurements (see the module doc).
 pub fn fit_rigid(meas: &[WindowMeasurement], cfg: &RobustConfig) -> Result<RigidMotion> {
     if meas.len() < 3 {
@@ -544,39 +647,20 @@ pub fn fit_rigid(meas: &[WindowMeasurement], cfg: &RobustConfig) -> Result<Rigid
     let mut p = Vector4::new(-u_mid, v_mid, 0.0, 0.0);
     let mut keep = vec![true; meas.len()];
     let mut info = Matrix4::zeros();
+    let mut soa = FitPoints::new(meas);
     for round in 0..2 {
         for _ in 0..8 {
+            let (upper, grad) =
+                rigid_normal_equations(cfg.flow.backend, &soa, &[p[0], p[1], p[2], p[3]], cfg.cauchy_px);
             let mut a = Matrix4::zeros();
-            let mut g = Vector4::zeros();
-            let sc = p[2].sin_cos();
-            for (m, &k) in meas.iter().zip(&keep) {
-                if !k {
-                    continue;
-                }
-                let (pred, j) = predict_with(m.u, m.v, &p, sc);
-                let e = [m.u + m.du - pred[0], m.v + m.dv - pred[1]];
-                let w = &m.info;
-                // Cauchy weight on the residual's Mahalanobis length in pixels.
-                let maha =
-                    (e[0] * (w[0][0] * e[0] + w[0][1] * e[1]) + e[1] * (w[1][0] * e[0] + w[1][1] * e[1])).max(0.0);
-                let scale = (w[0][0] + w[1][1]).max(1e-12) * 0.5;
-                let px2 = maha / scale;
-                let rw = 1.0 / (1.0 + px2 / (cfg.cauchy_px * cfg.cauchy_px));
-                // J^T W (4x2) once, then the rank-2 update of the 4x4 normal matrix.
-                let jtw: [[f64; 2]; 4] =
-                    std::array::from_fn(|r| std::array::from_fn(|l| rw * (j[0][r] * w[0][l] + j[1][r] * w[1][l])));
-                for r in 0..4 {
-                    for c in r..4 {
-                        a[(r, c)] += jtw[r][0] * j[0][c] + jtw[r][1] * j[1][c];
-                    }
-                    g[r] += jtw[r][0] * e[0] + jtw[r][1] * e[1];
-                }
-            }
+            let mut k = 0;
             for r in 0..4 {
-                for c in 0..r {
-                    a[(r, c)] = a[(c, r)];
+                for c in r..4 {
+                    (a[(r, c)], a[(c, r)]) = (upper[k], upper[k]);
+                    k += 1;
                 }
             }
+            let g = Vector4::from(grad);
             let step = a
                 .try_inverse()
                 .ok_or_else(|| OdometryError::NoTexture("the windows do not determine the motion".into()))?
@@ -591,12 +675,14 @@ pub fn fit_rigid(meas: &[WindowMeasurement], cfg: &RobustConfig) -> Result<Rigid
         if round == 0 {
             for (m, k) in meas.iter().zip(keep.iter_mut()) {
                 let (pred, _) = predict(m.u, m.v, &p);
-                let e = (m.u + m.du - pred[0]).hypot(m.v + m.dv - pred[1]);
-                *k = e <= cfg.reject_px;
+                let (ex, ey) = (m.u + m.du - pred[0], m.v + m.dv - pred[1]);
+                // Squared lengths: `hypot` took as long as a step of the fit.
+                *k = ex * ex + ey * ey <= cfg.reject_px * cfg.reject_px;
             }
             if keep.iter().filter(|k| **k).count() < 3 {
                 return Err(OdometryError::NoTexture("fewer than 3 windows agree on a motion".into()));
             }
+            soa.keep(&keep);
         }
     }
     // The information of the three motion parameters with the scale marginalized out.
@@ -702,6 +788,60 @@ mod tests {
         // gain, 0.012 % with the field. Through the spline one gain already does better
         // (0.013 % at 25 %), and at 50 % the field takes 0.054 % to 0.035 %.
         assert!(own < 0.8 * global && own < 5e-4, "gain field {own}, one gain {global}");
+    }
+
+    #[test]
+    fn the_fit_normal_equations_are_the_direct_sums_on_every_backend() {
+        let mut rng = ocellus_image::rng::SplitMix64::new(11);
+        let meas: Vec<WindowMeasurement> = (0..37)
+            .map(|_| {
+                let (a, b, c) = (rng.unit() * 50.0, rng.unit() * 10.0 - 5.0, rng.unit() * 40.0);
+                WindowMeasurement {
+                    u: rng.unit() * 400.0 - 200.0,
+                    v: rng.unit() * 400.0 - 200.0,
+                    du: rng.unit() * 6.0 - 3.0,
+                    dv: rng.unit() * 6.0 - 3.0,
+                    info: [[a, b], [b, c]],
+                }
+            })
+            .collect();
+        let keep: Vec<bool> = (0..meas.len()).map(|k| k % 5 != 2).collect();
+        let mut pts = FitPoints::new(&meas);
+        pts.keep(&keep);
+        let p = Vector4::new(0.8, -1.3, 0.01, 0.003);
+        let cauchy = 0.3;
+        // Window by window, as written in the module doc.
+        let (mut a, mut g) = (Matrix4::<f64>::zeros(), Vector4::<f64>::zeros());
+        for (m, _) in meas.iter().zip(&keep).filter(|(_, k)| **k) {
+            let (pred, j) = predict(m.u, m.v, &p);
+            let e = nalgebra::Vector2::new(m.u + m.du - pred[0], m.v + m.dv - pred[1]);
+            let w = nalgebra::Matrix2::new(m.info[0][0], m.info[0][1], m.info[1][0], m.info[1][1]);
+            let px2 = (e.transpose() * w * e)[0] / (0.5 * (m.info[0][0] + m.info[1][1]));
+            let jm = nalgebra::Matrix2x4::from_fn(|r, c| j[r][c]);
+            let rw = 1.0 / (1.0 + px2 / (cauchy * cauchy));
+            a += jm.transpose() * w * jm * rw;
+            g += jm.transpose() * w * e * rw;
+        }
+        let mut got = Vec::new();
+        for backend in [Backend::Scalar, Backend::Auto] {
+            let (upper, grad) = rigid_normal_equations(backend, &pts, &[p[0], p[1], p[2], p[3]], cauchy);
+            let mut k = 0;
+            for r in 0..4 {
+                for c in r..4 {
+                    assert!(
+                        (upper[k] - a[(r, c)]).abs() <= 1e-9 * a[(r, c)].abs().max(1.0),
+                        "{r},{c}: {} vs {}",
+                        upper[k],
+                        a[(r, c)]
+                    );
+                    k += 1;
+                }
+                assert!((grad[r] - g[r]).abs() <= 1e-9 * a[(r, r)].abs().max(1.0), "{r}: {} vs {}", grad[r], g[r]);
+            }
+            got.push((upper.map(f64::to_bits), grad.map(f64::to_bits)));
+        }
+        // The same sums in the same order on every backend.
+        assert_eq!(got[0], got[1]);
     }
 
     #[test]
