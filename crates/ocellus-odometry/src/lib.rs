@@ -7,7 +7,8 @@
 //! - [`kinematics`]: planar poses, and the camera-to-robot motion of seed eq. 20 (a camera
 //!   mounted off the rotation centre).
 //! - [`robust`]: beyond the seed: sub-pixel Lucas-Kanade refinement with per-window
-//!   uncertainty (the aperture problem), a robust fit of the exact rigid motion over all windows.
+//!   uncertainty (the aperture problem), then [`rigid_fit`]: a robust fit of the exact rigid
+//!   motion over all windows.
 //! - [`fusion`]: wheel encoders fused with vision: slips rejected, texture gaps bridged.
 //! - [`vo`]: the Kalman filter on the camera motion (Tx, Ty, wz) with the image-Jacobian
 //!   measurement model, in information form, and the integration to a robot trajectory.
@@ -28,6 +29,7 @@ mod gain_field;
 pub mod height;
 pub mod kinematics;
 pub mod lucas_kanade;
+pub mod rigid_fit;
 pub mod robust;
 pub mod sad_flow;
 pub mod spline;

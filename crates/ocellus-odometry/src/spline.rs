@@ -177,7 +177,7 @@ pub fn spline_kernel(sigma_px: f32) -> Vec<f32> {
 /// smoothing costs 0.11 instead of 0.16 ms per frame (this Zen 3 core); the smoothed
 /// pixels move by at most a few tenths of a grey level on a checkerboard-fine pattern, and
 /// far less on a floor's texture.
-const SPLINE_KERNEL_CUT: f64 = 1e-3;
+pub const SPLINE_KERNEL_CUT: f64 = 1e-3;
 
 /// The cubic B-spline's four weights for the pixels k-1, k, k+1, k+2 at `t` in [0, 1) past
 /// pixel k.
