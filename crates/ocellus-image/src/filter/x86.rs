@@ -83,18 +83,35 @@ pub(super) unsafe fn accumulate_rows_avx2(src: &Plane<f32>, rows: &[(usize, f32)
 /// sums in turn, the taps past the last whole four to the first, as `dot8` does.
 #[target_feature(enable = "avx2,fma")]
 pub(super) unsafe fn tail_quads(ptrs: &[*const f32], wts: &[f32], o: *mut f32, mut x: usize, n: usize) {
-    let quads = ptrs.len() / 4 * 4;
+    /// `a + w * p[x .. x + 8]` (a function, not a closure, to be compiled with AVX2 and FMA).
+    #[inline(always)]
+    unsafe fn fma8(w: f32, p: *const f32, x: usize, a: __m256) -> __m256 {
+        // SAFETY: the caller keeps [x, x + 8) within the row.
+        unsafe { _mm256_fmadd_ps(_mm256_set1_ps(w), _mm256_loadu_ps(p.add(x)), a) }
+    }
+    let quads = ptrs.len().min(wts.len()) / 4 * 4;
     // SAFETY: the caller's rows and output hold n >= 8 values; every access covers
     // [x0, x0 + 8) with x0 + 8 <= n.
     unsafe {
         while x < n {
             let x0 = if x + 8 <= n { x } else { n - 8 };
-            let mut a = [_mm256_setzero_ps(); 4];
-            for (t, (&p, &w)) in ptrs.iter().zip(wts).enumerate() {
-                let i = if t < quads { t % 4 } else { 0 };
-                a[i] = _mm256_fmadd_ps(_mm256_set1_ps(w), _mm256_loadu_ps(p.add(x0)), a[i]);
+            // Four named sums, not an array indexed by `t % 4`: a computed index kept the
+            // sums on the stack, each multiply-add waiting on a store and a reload (the
+            // Gabor bank's column passes on a 20x15 level spent 60 % of their time here).
+            let [mut a0, mut a1, mut a2, mut a3] = [_mm256_setzero_ps(); 4];
+            let mut t = 0;
+            while t < quads {
+                a0 = fma8(wts[t], ptrs[t], x0, a0);
+                a1 = fma8(wts[t + 1], ptrs[t + 1], x0, a1);
+                a2 = fma8(wts[t + 2], ptrs[t + 2], x0, a2);
+                a3 = fma8(wts[t + 3], ptrs[t + 3], x0, a3);
+                t += 4;
             }
-            _mm256_storeu_ps(o.add(x0), _mm256_add_ps(_mm256_add_ps(a[0], a[1]), _mm256_add_ps(a[2], a[3])));
+            while t < ptrs.len().min(wts.len()) {
+                a0 = fma8(wts[t], ptrs[t], x0, a0);
+                t += 1;
+            }
+            _mm256_storeu_ps(o.add(x0), _mm256_add_ps(_mm256_add_ps(a0, a1), _mm256_add_ps(a2, a3)));
             x = x0 + 8;
         }
     }
