@@ -139,6 +139,52 @@ pub struct PyrScratch {
     odd3: [Vec<f32>; 3],
     row16: Vec<u16>,
     itaps: Vec<(usize, u16)>,
+    itaps_interior: Vec<(usize, u16)>,
+    border: BorderTaps,
+}
+
+/// The taps of the outputs of a decimated row of `w` samples that reach past its ends
+/// (outputs `j < lo` and `j >= hi` of [`PyramidKernel::interior`]), the same for every row of
+/// a level: built once per level, not per row and output (the renormalized taps cost about
+/// as much as the row's arithmetic on the small levels, where a row is a few vectors).
+#[derive(Default, Debug, Clone)]
+struct BorderTaps {
+    taps: Vec<(usize, f32)>,
+    /// (output j, start, end) of its taps in `taps`.
+    outputs: Vec<(usize, usize, usize)>,
+}
+
+impl BorderTaps {
+    fn build(&mut self, kernel: &PyramidKernel, w: usize, scratch: &mut Vec<(usize, f32)>) {
+        self.taps.clear();
+        self.outputs.clear();
+        let (lo, hi) = kernel.interior(w);
+        for j in (0..lo).chain(hi.max(lo)..w / 2) {
+            kernel.taps_for(j, w, scratch);
+            let start = self.taps.len();
+            self.taps.extend_from_slice(scratch);
+            self.outputs.push((j, start, self.taps.len()));
+        }
+    }
+}
+
+/// The taps of output `j` of a dimension of `n` samples into `out`: for an interior output
+/// (all taps inside), `interior` (the taps of output `lo`) shifted by `2 (j - lo)` samples,
+/// the same weights as [`PyramidKernel::taps_for`] computes for it; otherwise that.
+#[inline(always)]
+fn taps_at<T: Copy>(
+    j: usize,
+    (lo, hi): (usize, usize),
+    interior: &[(usize, T)],
+    out: &mut Vec<(usize, T)>,
+    border: impl FnOnce(&mut Vec<(usize, T)>),
+) {
+    if (lo..hi).contains(&j) {
+        out.clear();
+        out.extend(interior.iter().map(|&(i, w)| (i + 2 * (j - lo), w)));
+    } else {
+        border(out);
+    }
 }
 
 /// Longest pyramid kernel supported (taps).
@@ -235,16 +281,18 @@ fn decimate_one<M: Madd>(
     odd: &[f32],
     w: usize,
     kernel: &PyramidKernel,
-    taps: &mut Vec<(usize, f32)>,
+    border: &BorderTaps,
     out: &mut [f32],
 ) {
     let (lo, hi) = kernel.interior(w);
     if hi > lo {
         decimate_interior_generic::<M>(even, odd, &kernel.taps, kernel.origin, lo, &mut out[lo..hi]);
     }
-    for j in (0..lo).chain(hi.max(lo)..out.len()) {
-        kernel.taps_for(j, w, taps);
-        out[j] = taps.iter().map(|&(i, wt)| wt * if i % 2 == 0 { even[i / 2] } else { odd[i / 2] }).sum();
+    for &(j, a, b) in &border.outputs {
+        let taps = &border.taps[a..b];
+        if let Some(o) = out.get_mut(j) {
+            *o = taps.iter().map(|&(i, wt)| wt * if i % 2 == 0 { even[i / 2] } else { odd[i / 2] }).sum();
+        }
     }
 }
 
@@ -280,12 +328,17 @@ fn pyr_down_generic<M: Madd>(src: &Plane<f32>, dst: &mut Plane<f32>, kernel: &Py
     let (ow, oh) = next_size(w, h);
     // Vertical first: full-width rows vectorize without shuffles.
     s.vert.resize(w, oh);
+    let inner = kernel.interior(h);
+    if inner.1 > inner.0 {
+        kernel.taps_for(inner.0, h, &mut s.taps2);
+    }
     for j in 0..oh {
-        kernel.taps_for(j, h, &mut s.taps);
+        taps_at(j, inner, &s.taps2, &mut s.taps, |t| kernel.taps_for(j, h, t));
         accumulate_rows_best::<M>(src, &s.taps, s.vert.row_mut(j));
     }
     dst.resize(ow, oh);
-    decimate_rows::<M>(&s.vert, dst, kernel, &mut s.even, &mut s.odd, &mut s.taps);
+    s.border.build(kernel, w, &mut s.taps);
+    decimate_rows::<M>(&s.vert, dst, kernel, &mut s.even, &mut s.odd, &s.border);
 }
 
 dispatch_kernel!(fn pyr_down_kernel => pyr_down_generic(src: &Plane<f32>, dst: &mut Plane<f32>, kernel: &PyramidKernel, s: &mut PyrScratch));
@@ -298,12 +351,12 @@ fn decimate_rows<M: Madd>(
     kernel: &PyramidKernel,
     even: &mut Vec<f32>,
     odd: &mut Vec<f32>,
-    taps: &mut Vec<(usize, f32)>,
+    border: &BorderTaps,
 ) {
     let w = vert.width();
     for y in 0..dst.height() {
         deinterleave(vert.row(y), even, odd);
-        decimate_one::<M>(even, odd, w, kernel, taps, dst.row_mut(y));
+        decimate_one::<M>(even, odd, w, kernel, border, dst.row_mut(y));
     }
 }
 
@@ -342,11 +395,17 @@ fn pyr_down_rgb8_generic<M: Madd>(
         s.odd3[c].resize(w / 2, 0.0);
     }
     let integer = kernel.integer_taps();
-    if integer.is_some() {
+    let inner = kernel.interior(h);
+    let mut d_inner = 1;
+    if let Some(ik) = &integer {
         s.row16.resize(3 * w, 0);
+        if inner.1 > inner.0 {
+            d_inner = ik.taps_for(kernel, inner.0, h, &mut s.taps, &mut s.itaps_interior);
+        }
     } else {
         s.row3.resize(3 * w, 0.0);
     }
+    s.border.build(kernel, w, &mut s.taps);
     for j in 0..d0.height() {
         let [e0, e1, e2] = &mut s.even3;
         let [o0, o1, o2] = &mut s.odd3;
@@ -355,7 +414,8 @@ fn pyr_down_rgb8_generic<M: Madd>(
         if let Some(ik) = &integer {
             // Exact integer sums of bytes (see `IntegerTaps`), then one scaling to [0, 1] as
             // the samples are split into even/odd per channel.
-            let d = ik.taps_for(kernel, j, h, &mut s.taps, &mut s.itaps);
+            let mut d = d_inner;
+            taps_at(j, inner, &s.itaps_interior, &mut s.itaps, |t| d = ik.taps_for(kernel, j, h, &mut s.taps, t));
             vertical_bytes_u16(src, &s.itaps, &mut s.row16);
             split_even_odd(&s.row16, 1.0 / (d as f32 * 255.0), [e0, e1, e2], [o0, o1, o2]);
         } else {
@@ -364,7 +424,7 @@ fn pyr_down_rgb8_generic<M: Madd>(
             split_even_odd(&s.row3, 1.0, [e0, e1, e2], [o0, o1, o2]);
         }
         for (c, d) in [&mut *d0, &mut *d1, &mut *d2].into_iter().enumerate() {
-            decimate_one::<M>(&s.even3[c], &s.odd3[c], w, kernel, &mut s.taps2, d.row_mut(j));
+            decimate_one::<M>(&s.even3[c], &s.odd3[c], w, kernel, &s.border, d.row_mut(j));
         }
     }
 }
