@@ -203,14 +203,20 @@ fn decimate_interior_generic<M: Madd>(even: &[f32], odd: &[f32], k: &[f32], orig
     let plan = &plan[..k.len().min(MAX_TAPS)];
     let n = out.len();
     let mut j = 0;
-    // 64 outputs at a time: eight independent 256-bit chains (four 512-bit), enough to hide
-    // the multiply-add latency over a kernel of six taps; then 32.
+    // The taps alternate between the halves: tap 0's half first.
+    let (a, b) = if plan.first().is_some_and(|p| p.0) { (odd, even) } else { (even, odd) };
+    // 128 outputs at a time: eight independent 512-bit chains (sixteen 256-bit), enough to
+    // hide the multiply-add latency over a kernel of six taps; then 64 and 32.
+    while j + 128 <= n {
+        decimate_chunk::<M, 128>(a, b, plan, j, out);
+        j += 128;
+    }
     while j + 64 <= n {
-        decimate_chunk::<M, 64>(even, odd, plan, j, out);
+        decimate_chunk::<M, 64>(a, b, plan, j, out);
         j += 64;
     }
     while j + 32 <= n {
-        decimate_chunk::<M, 32>(even, odd, plan, j, out);
+        decimate_chunk::<M, 32>(a, b, plan, j, out);
         j += 32;
     }
     // 8 at a time, then one 8-wide chunk aligned to the end (recomputes a few outputs).
@@ -237,21 +243,29 @@ fn decimate_interior_generic<M: Madd>(even: &[f32], odd: &[f32], k: &[f32], orig
     }
 }
 
-/// `C` outputs of [`decimate_interior_generic`] from `j`.
+/// `C` outputs of [`decimate_interior_generic`] from `j`; even taps read `a`, odd taps `b`
+/// (the halves alternate from tap to tap), taken two at a time so that no tap chooses its
+/// half at run time.
 #[inline(always)]
 fn decimate_chunk<M: Madd, const C: usize>(
-    even: &[f32],
-    odd: &[f32],
+    a: &[f32],
+    b: &[f32],
     plan: &[(bool, usize, f32)],
     j: usize,
     out: &mut [f32],
 ) {
     let mut acc = [0f32; C];
-    for &(is_odd, base, kt) in plan {
-        let src = if is_odd { odd } else { even };
-        let Ok(s) = <&[f32; C]>::try_from(&src[base + j..base + j + C]) else { return };
+    for pair in plan.chunks(2) {
+        let (_, base, kt) = pair[0];
+        let Ok(s) = <&[f32; C]>::try_from(&a[base + j..base + j + C]) else { return };
         for l in 0..C {
             acc[l] = M::madd(kt, s[l], acc[l]);
+        }
+        if let Some(&(_, base, kt)) = pair.get(1) {
+            let Ok(s) = <&[f32; C]>::try_from(&b[base + j..base + j + C]) else { return };
+            for l in 0..C {
+                acc[l] = M::madd(kt, s[l], acc[l]);
+            }
         }
     }
     out[j..j + C].copy_from_slice(&acc);
