@@ -23,8 +23,8 @@ pub fn abs_difference(center: &Plane<f32>, surround: &Plane<f32>, out: &mut Plan
     out.resize(w, h);
     for y in 0..h {
         let (c, s) = (center.row(y), surround.row(y));
-        for (x, o) in out.row_mut(y).iter_mut().enumerate() {
-            *o = (c[x] - s[x]).abs();
+        for ((o, a), b) in out.row_mut(y).iter_mut().zip(c).zip(s) {
+            *o = (a - b).abs();
         }
     }
 }
