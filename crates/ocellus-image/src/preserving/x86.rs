@@ -132,20 +132,27 @@ pub(super) unsafe fn preserving_lanes_avx512(
             }
         }
     }
-    // Vertical pass row by row: the horizontal pass's output (40 x 30 maps: 38 KB) stays in L1.
+    // Vertical pass two output rows at a time (one row last when h is odd): the horizontal
+    // pass's output (40 x 30 maps: 38 KB) stays in L1.
     let tmp = s.tmp.as_ptr() as *const f32;
-    for (y, r) in rows.iter().enumerate().take(h) {
+    let mut y = 0;
+    while y < h {
         let out = dst.row_mut(y).as_mut_ptr() as *mut f32;
+        let next = (y + 1 < h).then(|| dst.row_mut(y + 1).as_mut_ptr() as *mut f32);
         for (x0, p) in blocks(w) {
             // SAFETY: every tap's row is below h (checked above) and x0 + 2 P <= w <= wp.
             unsafe {
-                match p {
-                    8 => col_block::<8>(tmp, npair * 16, r, out, x0),
-                    4 => col_block::<4>(tmp, npair * 16, r, out, x0),
-                    _ => col_block::<1>(tmp, npair * 16, r, out, x0),
+                match (next, p) {
+                    (Some(o1), 8) => col_block2::<8>(tmp, npair * 16, [&rows[y], &rows[y + 1]], [out, o1], x0),
+                    (Some(o1), 4) => col_block2::<4>(tmp, npair * 16, [&rows[y], &rows[y + 1]], [out, o1], x0),
+                    (Some(o1), _) => col_block2::<1>(tmp, npair * 16, [&rows[y], &rows[y + 1]], [out, o1], x0),
+                    (None, 8) => col_block::<8>(tmp, npair * 16, &rows[y], out, x0),
+                    (None, 4) => col_block::<4>(tmp, npair * 16, &rows[y], out, x0),
+                    (None, _) => col_block::<1>(tmp, npair * 16, &rows[y], out, x0),
                 }
             }
         }
+        y += 2;
     }
     true
 }
@@ -221,6 +228,59 @@ unsafe fn col_block<const P: usize>(tmp: *const f32, stride: usize, taps: &[(usi
         }
         for (j, a) in a.iter().enumerate() {
             _mm512_storeu_ps(out.add((x0 + 2 * j) * 8), *a);
+        }
+    }
+}
+
+/// `2 P` outputs of the vertical pass from pixel `x0` in two output rows at once: each row of
+/// `tmp` that both rows' taps read is loaded once for both sums (the taps of rows y and y + 1
+/// are runs of consecutive rows, one apart), instead of once per output row. Each sum takes
+/// its taps in their order, so the chains are those of [`col_block`].
+#[inline(always)]
+unsafe fn col_block2<const P: usize>(
+    tmp: *const f32,
+    stride: usize,
+    taps: [&[(usize, f32)]; 2],
+    out: [*mut f32; 2],
+    x0: usize,
+) {
+    // SAFETY: the caller keeps [x0, x0 + 2 P) within the rows and every r_i < height.
+    unsafe {
+        let mut a = [[_mm512_setzero_ps(); P]; 2];
+        let (mut i, mut j) = (0, 0);
+        loop {
+            // The next row of either list, the lower first (both lists ascend).
+            let (ri, rj) = (taps[0].get(i).map(|t| t.0), taps[1].get(j).map(|t| t.0));
+            let r = match (ri, rj) {
+                (Some(p), Some(q)) => p.min(q),
+                (Some(p), None) => p,
+                (None, Some(q)) => q,
+                (None, None) => break,
+            };
+            let s = tmp.add(r * stride + x0 * 8);
+            let mut v = [_mm512_setzero_ps(); P];
+            for (k, v) in v.iter_mut().enumerate() {
+                *v = _mm512_loadu_ps(s.add(16 * k));
+            }
+            if ri == Some(r) {
+                let wv = _mm512_set1_ps(taps[0][i].1);
+                for k in 0..P {
+                    a[0][k] = _mm512_fmadd_ps(wv, v[k], a[0][k]);
+                }
+                i += 1;
+            }
+            if rj == Some(r) {
+                let wv = _mm512_set1_ps(taps[1][j].1);
+                for k in 0..P {
+                    a[1][k] = _mm512_fmadd_ps(wv, v[k], a[1][k]);
+                }
+                j += 1;
+            }
+        }
+        for (o, a) in out.iter().zip(&a) {
+            for (k, a) in a.iter().enumerate() {
+                _mm512_storeu_ps(o.add((x0 + 2 * k) * 8), *a);
+            }
         }
     }
 }
