@@ -89,7 +89,8 @@ pub(super) unsafe fn tail_quads(ptrs: &[*const f32], wts: &[f32], o: *mut f32, m
         // SAFETY: the caller keeps [x, x + 8) within the row.
         unsafe { _mm256_fmadd_ps(_mm256_set1_ps(w), _mm256_loadu_ps(p.add(x)), a) }
     }
-    let quads = ptrs.len().min(wts.len()) / 4 * 4;
+    let taps = ptrs.len().min(wts.len());
+    let quads = taps / 4 * 4;
     // SAFETY: the caller's rows and output hold n >= 8 values; every access covers
     // [x0, x0 + 8) with x0 + 8 <= n.
     unsafe {
@@ -107,7 +108,7 @@ pub(super) unsafe fn tail_quads(ptrs: &[*const f32], wts: &[f32], o: *mut f32, m
                 a3 = fma8(wts[t + 3], ptrs[t + 3], x0, a3);
                 t += 4;
             }
-            while t < ptrs.len().min(wts.len()) {
+            while t < taps {
                 a0 = fma8(wts[t], ptrs[t], x0, a0);
                 t += 1;
             }

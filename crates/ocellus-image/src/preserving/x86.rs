@@ -138,14 +138,16 @@ pub(super) unsafe fn preserving_lanes_avx512(
     let mut y = 0;
     while y < h {
         let out = dst.row_mut(y).as_mut_ptr() as *mut f32;
-        let next = (y + 1 < h).then(|| dst.row_mut(y + 1).as_mut_ptr() as *mut f32);
+        // Rows y and y + 1 together, when y + 1 exists.
+        let pair =
+            (y + 1 < h).then(|| ([&rows[y][..], &rows[y + 1][..]], [out, dst.row_mut(y + 1).as_mut_ptr() as *mut f32]));
         for (x0, p) in blocks(w) {
             // SAFETY: every tap's row is below h (checked above) and x0 + 2 P <= w <= wp.
             unsafe {
-                match (next, p) {
-                    (Some(o1), 8) => col_block2::<8>(tmp, npair * 16, [&rows[y], &rows[y + 1]], [out, o1], x0),
-                    (Some(o1), 4) => col_block2::<4>(tmp, npair * 16, [&rows[y], &rows[y + 1]], [out, o1], x0),
-                    (Some(o1), _) => col_block2::<1>(tmp, npair * 16, [&rows[y], &rows[y + 1]], [out, o1], x0),
+                match (pair, p) {
+                    (Some((t, o)), 8) => col_block2::<8>(tmp, npair * 16, t, o, x0),
+                    (Some((t, o)), 4) => col_block2::<4>(tmp, npair * 16, t, o, x0),
+                    (Some((t, o)), _) => col_block2::<1>(tmp, npair * 16, t, o, x0),
                     (None, 8) => col_block::<8>(tmp, npair * 16, &rows[y], out, x0),
                     (None, 4) => col_block::<4>(tmp, npair * 16, &rows[y], out, x0),
                     (None, _) => col_block::<1>(tmp, npair * 16, &rows[y], out, x0),
