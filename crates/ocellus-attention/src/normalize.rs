@@ -7,6 +7,9 @@ use ocellus_image::preserving::{Lanes, PreservingFilter};
 use ocellus_image::simd::Madd;
 use ocellus_image::{dispatch_kernel, Backend, Plane};
 
+#[cfg(target_arch = "x86_64")]
+mod x86;
+
 /// One competition step: `M <- max(0, M + E - I - c)`.
 #[inline(always)]
 #[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
@@ -195,6 +198,12 @@ impl Normalizer {
 #[inline(always)]
 #[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
 fn lanes_min_max_generic<M: Madd>(maps: &Plane<Lanes>) -> (Lanes, Lanes) {
+    #[cfg(target_arch = "x86_64")]
+    if M::AVX512 {
+        // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512, which
+        // `dispatch_kernel!` calls only on CPUs that have it.
+        return unsafe { x86::lanes_min_max(maps) };
+    }
     let (mut mn, mut mx) = ([f32::INFINITY; 8], [f32::NEG_INFINITY; 8]);
     for r in maps.rows() {
         for p in r {
@@ -212,6 +221,11 @@ dispatch_kernel!(fn lanes_min_max => lanes_min_max_generic(maps: &Plane<Lanes>) 
 /// `v <- max(0, v) * scale + offset` per lane.
 #[inline(always)]
 fn lanes_affine_generic<M: Madd>(maps: &mut Plane<Lanes>, scale: Lanes, offset: Lanes) {
+    #[cfg(target_arch = "x86_64")]
+    if M::AVX512 {
+        // SAFETY: as in `lanes_min_max_generic`.
+        return unsafe { x86::lanes_affine(maps, &scale, &offset) };
+    }
     for y in 0..maps.height() {
         for p in maps.row_mut(y) {
             for l in 0..8 {
@@ -227,6 +241,11 @@ dispatch_kernel!(fn lanes_affine => lanes_affine_generic(maps: &mut Plane<Lanes>
 #[inline(always)]
 #[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
 fn compete_lanes_generic<M: Madd>(maps: &mut Plane<Lanes>, excit: &Plane<Lanes>, inhib: &Plane<Lanes>, c: Lanes) {
+    #[cfg(target_arch = "x86_64")]
+    if M::AVX512 {
+        // SAFETY: as in `lanes_min_max_generic`.
+        return unsafe { x86::compete_lanes(maps, excit, inhib, &c) };
+    }
     for y in 0..maps.height() {
         let (e, i) = (excit.row(y), inhib.row(y));
         for ((p, ev), iv) in maps.row_mut(y).iter_mut().zip(e).zip(i) {
@@ -274,5 +293,46 @@ fn local_max(map: &mut Plane<f32>, range: Option<f32>) {
     };
     for y in 0..h {
         map.row_mut(y).iter_mut().for_each(|v| *v *= f);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The AVX-512 forms of the per-pixel steps give the generic kernels' results bit for bit,
+    /// on widths with and without an odd last pixel.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx512_lane_steps_equal_the_generic_ones_bit_for_bit() {
+        if !ocellus_image::simd::avx512_available() {
+            return;
+        }
+        use ocellus_image::simd::Fused;
+        let bits = |p: &Plane<Lanes>| -> Vec<u32> {
+            p.rows().flat_map(|r| r.as_flattened().iter().map(|v| v.to_bits())).collect()
+        };
+        let mut rng = ocellus_image::rng::SplitMix64::new(11);
+        for (w, h) in [(1, 1), (2, 3), (7, 5), (40, 30), (41, 31)] {
+            let mut map = || -> Plane<Lanes> {
+                Plane::from_fn(w, h, |_, _| std::array::from_fn(|_| rng.unit() as f32 * 4.0 - 1.0))
+            };
+            let (m, e, i) = (map(), map(), map());
+            let c: Lanes = std::array::from_fn(|l| 0.1 * l as f32);
+            let s: Lanes = std::array::from_fn(|l| 1.0 + 0.37 * l as f32);
+            // SAFETY: AVX-512 was checked above.
+            let got = unsafe { x86::lanes_min_max(&m) };
+            assert_eq!(got, lanes_min_max_generic::<Fused>(&m), "{w}x{h} min/max");
+            let (mut a, mut b) = (m.clone(), m.clone());
+            lanes_affine_generic::<Fused>(&mut a, s, c);
+            // SAFETY: as above.
+            unsafe { x86::lanes_affine(&mut b, &s, &c) };
+            assert_eq!(bits(&a), bits(&b), "{w}x{h} affine");
+            let (mut a, mut b) = (m.clone(), m.clone());
+            compete_lanes_generic::<Fused>(&mut a, &e, &i, c);
+            // SAFETY: as above.
+            unsafe { x86::compete_lanes(&mut b, &e, &i, &c) };
+            assert_eq!(bits(&a), bits(&b), "{w}x{h} compete");
+        }
     }
 }

@@ -27,6 +27,34 @@ pub struct Resampler {
     dst: (usize, usize),
     xs: AxisTable,
     ys: AxisTable,
+    cols: Columns,
+}
+
+/// The x table split into columns of 32-bit indices and weights, the form vector gathers
+/// read.
+#[derive(Clone, Debug, Default)]
+struct Columns {
+    i0: Vec<i32>,
+    i1: Vec<i32>,
+    w: Vec<f32>,
+    /// The largest index of either column (the row must be longer).
+    max_index: usize,
+}
+
+impl Columns {
+    /// Empty (so unused) when an index does not fit 32 bits.
+    fn new(xs: &AxisTable) -> Self {
+        let max_index = xs.iter().map(|&(a, b, _)| a.max(b)).max().unwrap_or(0);
+        if i32::try_from(max_index).is_err() {
+            return Self::default();
+        }
+        Self {
+            i0: xs.iter().map(|&(a, _, _)| a as i32).collect(),
+            i1: xs.iter().map(|&(_, b, _)| b as i32).collect(),
+            w: xs.iter().map(|&(_, _, w)| w).collect(),
+            max_index,
+        }
+    }
 }
 
 fn bilinear_axis(n_in: usize, n_out: usize) -> AxisTable {
@@ -63,7 +91,8 @@ impl Resampler {
             ResampleMethod::Bilinear => (bilinear_axis(src.0, dst.0), bilinear_axis(src.1, dst.1)),
             ResampleMethod::Nearest => (nearest_axis(src.0, dst.0), nearest_axis(src.1, dst.1)),
         };
-        Ok(Self { src, dst, xs, ys })
+        let cols = Columns::new(&xs);
+        Ok(Self { src, dst, xs, ys, cols })
     }
 
     /// Source size (w, h).
@@ -96,7 +125,7 @@ impl Resampler {
     ) -> Result<()> {
         crate::check::same_size("resampler input", src.size(), self.src)?;
         dst.resize(self.dst.0, self.dst.1);
-        resample_kernel(backend, &self.xs, &self.ys, src, dst, row);
+        resample_kernel(backend, &self.xs, &self.cols, &self.ys, src, dst, row);
         Ok(())
     }
 
@@ -111,6 +140,7 @@ impl Resampler {
 #[inline(always)]
 fn resample_generic<M: Madd>(
     xs: &AxisTable,
+    cols: &Columns,
     ys: &AxisTable,
     src: &Plane<f32>,
     dst: &mut Plane<f32>,
@@ -126,14 +156,33 @@ fn resample_generic<M: Madd>(
                 *o = M::madd(fy, b - a, a);
             }
         }
-        for (o, &(x0, x1, fx)) in dst.row_mut(y).iter_mut().zip(xs) {
+        let out = dst.row_mut(y);
+        #[cfg(target_arch = "x86_64")]
+        if M::AVX2 && cols.max_index < row.len() && cols.i0.len() >= out.len() {
+            // SAFETY: `M::AVX2` (`M::AVX512`) is true only inside kernels compiled for AVX2
+            // and FMA (AVX-512), which `dispatch_kernel!` calls only on CPUs that have them;
+            // the bounds are checked just above.
+            unsafe {
+                if M::AVX512 {
+                    x86::columns_avx512(cols, row, out);
+                } else {
+                    x86::columns_avx2(cols, row, out);
+                }
+            }
+            continue;
+        }
+        let _ = cols;
+        for (o, &(x0, x1, fx)) in out.iter_mut().zip(xs) {
             *o = M::madd(fx, row[x1] - row[x0], row[x0]);
         }
     }
 }
 
+#[cfg(target_arch = "x86_64")]
+mod x86;
+
 dispatch_kernel!(fn resample_kernel => resample_generic(
-    xs: &AxisTable, ys: &AxisTable, src: &Plane<f32>, dst: &mut Plane<f32>, row: &mut Vec<f32>
+    xs: &AxisTable, cols: &Columns, ys: &AxisTable, src: &Plane<f32>, dst: &mut Plane<f32>, row: &mut Vec<f32>
 ));
 
 /// Bilinear sample of `img` at (x, y), pixel centres at integers; positions outside the image
@@ -156,4 +205,52 @@ pub fn resize(backend: Backend, src: &Plane<f32>, w: usize, h: usize, method: Re
     let mut dst = Plane::default();
     r.apply(backend, src, &mut dst)?;
     Ok(dst)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The gathering kernels give the generic kernel's results bit for bit, downsampling and
+    /// upsampling, on widths around their vector lengths.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn gathering_kernels_equal_the_generic_kernel_bit_for_bit() {
+        if !crate::simd::avx2_available() {
+            return;
+        }
+        let mut rng = crate::rng::SplitMix64::new(3);
+        for (sw, sh, dw, dh) in [(160, 120, 40, 30), (20, 15, 40, 30), (5, 3, 40, 30), (2, 1, 7, 3), (33, 9, 17, 5)] {
+            let src = Plane::from_fn(sw, sh, |_, _| rng.unit() as f32);
+            let r = Resampler::new(ResampleMethod::Bilinear, (sw, sh), (dw, dh)).unwrap_or_else(|e| panic!("{e}"));
+            let mut want = Plane::new(dw, dh);
+            // Empty columns: the generic loop.
+            resample_generic::<crate::simd::Fused>(&r.xs, &Columns::default(), &r.ys, &src, &mut want, &mut Vec::new());
+            let mut row = vec![0.0; sw];
+            for avx512 in [false, true] {
+                if avx512 && !crate::simd::avx512_available() {
+                    continue;
+                }
+                for y in 0..dh {
+                    let (y0, y1, fy) = r.ys[y];
+                    for (x, o) in row.iter_mut().enumerate() {
+                        let (a, b) = (src.get(x, y0), src.get(x, y1));
+                        *o = if fy == 0.0 { a } else { fy.mul_add(b - a, a) };
+                    }
+                    let mut out = vec![f32::NAN; dw];
+                    // SAFETY: AVX2 (and AVX-512 when asked) checked above; the columns index
+                    // a row of the source's width.
+                    unsafe {
+                        if avx512 {
+                            x86::columns_avx512(&r.cols, &row, &mut out)
+                        } else {
+                            x86::columns_avx2(&r.cols, &row, &mut out)
+                        }
+                    }
+                    let same = out.iter().zip(want.row(y)).all(|(a, b)| a.to_bits() == b.to_bits());
+                    assert!(same, "{sw}x{sh} -> {dw}x{dh}, row {y}, avx512 {avx512}");
+                }
+            }
+        }
+    }
 }

@@ -1,0 +1,62 @@
+//! The horizontal step of resampling with vector gathers.
+//!
+//! Why by hand: each output reads two table-chosen samples of the row, which the compiler
+//! leaves as scalar loads (about a nanosecond per output on the saliency engine's 42 maps
+//! a frame, 6 % of it). A 512-bit gather reads 16 of them in about 3 ns. Each output is the
+//! generic kernel's `fma(w, b - a, a)`, so the results are the same bit for bit (tested).
+
+use super::Columns;
+use std::arch::x86_64::*;
+
+/// `out[o] = fma(w[o], row[i1[o]] - row[i0[o]], row[i0[o]])` for every output, 16 at a time.
+///
+/// # Safety
+/// The CPU must have AVX-512 F (and AVX2, FMA); `cols.max_index < row.len()` and the tables
+/// at least `out.len()` long (the caller checks both).
+#[target_feature(enable = "avx512f,avx2,fma")]
+pub(super) unsafe fn columns_avx512(cols: &Columns, row: &[f32], out: &mut [f32]) {
+    let n = out.len();
+    let mut o = 0;
+    // SAFETY: every index is at most `max_index < row.len()`, and o + 16 <= n <= table lengths.
+    unsafe {
+        while o + 16 <= n {
+            let i0 = _mm512_loadu_si512(cols.i0.as_ptr().add(o) as *const _);
+            let i1 = _mm512_loadu_si512(cols.i1.as_ptr().add(o) as *const _);
+            let w = _mm512_loadu_ps(cols.w.as_ptr().add(o));
+            let a = _mm512_i32gather_ps::<4>(i0, row.as_ptr());
+            let b = _mm512_i32gather_ps::<4>(i1, row.as_ptr());
+            _mm512_storeu_ps(out.as_mut_ptr().add(o), _mm512_fmadd_ps(w, _mm512_sub_ps(b, a), a));
+            o += 16;
+        }
+    }
+    for o in o..n {
+        let (a, b) = (row[cols.i0[o] as usize], row[cols.i1[o] as usize]);
+        out[o] = cols.w[o].mul_add(b - a, a);
+    }
+}
+
+/// [`columns_avx512`] with 256-bit gathers, 8 outputs at a time.
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA; the same bounds as [`columns_avx512`].
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn columns_avx2(cols: &Columns, row: &[f32], out: &mut [f32]) {
+    let n = out.len();
+    let mut o = 0;
+    // SAFETY: as in `columns_avx512`, 8 at a time.
+    unsafe {
+        while o + 8 <= n {
+            let i0 = _mm256_loadu_si256(cols.i0.as_ptr().add(o) as *const __m256i);
+            let i1 = _mm256_loadu_si256(cols.i1.as_ptr().add(o) as *const __m256i);
+            let w = _mm256_loadu_ps(cols.w.as_ptr().add(o));
+            let a = _mm256_i32gather_ps::<4>(row.as_ptr(), i0);
+            let b = _mm256_i32gather_ps::<4>(row.as_ptr(), i1);
+            _mm256_storeu_ps(out.as_mut_ptr().add(o), _mm256_fmadd_ps(w, _mm256_sub_ps(b, a), a));
+            o += 8;
+        }
+    }
+    for o in o..n {
+        let (a, b) = (row[cols.i0[o] as usize], row[cols.i1[o] as usize]);
+        out[o] = cols.w[o].mul_add(b - a, a);
+    }
+}
