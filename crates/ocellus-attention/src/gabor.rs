@@ -11,7 +11,7 @@
 
 use crate::config::{GaborBorder, GaborConfig};
 use crate::Result;
-use ocellus_image::filter::{filter_cols, filter_rows, sep_filter, Border, FilterScratch};
+use ocellus_image::filter::{filter_cols, filter_rows_bank, Border, FilterScratch};
 use ocellus_image::simd::Madd;
 use ocellus_image::{dispatch_kernel, Backend, Plane};
 
@@ -85,8 +85,14 @@ pub struct GaborBank {
     ones: Vec<f32>,
     scratch: FilterScratch,
     box_: Plane<f32>,
-    hr: Plane<f32>,
-    hi: Plane<f32>,
+    /// The kernels of the row pass, applied to the input together: the box's ones, then per
+    /// angle that is not a mirror its `hr` and (when not zero) its `hi`.
+    row_kernels: Vec<Vec<f32>>,
+    /// Per angle: the indices in `row_kernels` (and `rows`) of its `hr` and `hi` (a mirror
+    /// angle's are its original's).
+    row_index: Vec<(usize, Option<usize>)>,
+    /// The row pass's outputs, one per row kernel.
+    rows: Vec<Plane<f32>>,
     /// Per angle: [Hr*vr, Hi*vi, Hr*vi, Hi*vr] of the last level (mirror angles read their
     /// original's).
     parts: Vec<[Plane<f32>; 4]>,
@@ -145,6 +151,24 @@ impl GaborBank {
             });
         }
         let parts = (0..angles.len()).map(|_| Default::default()).collect();
+        let mut row_kernels = vec![vec![1.0; n]];
+        let mut row_index: Vec<(usize, Option<usize>)> = Vec::with_capacity(angles.len());
+        for f in &angles {
+            let idx = match f.mirror_of {
+                Some(m) => row_index[m],
+                None => {
+                    row_kernels.push(f.hr.clone());
+                    let hr = row_kernels.len() - 1;
+                    let hi = f.hi.as_ref().map(|hi| {
+                        row_kernels.push(hi.clone());
+                        row_kernels.len() - 1
+                    });
+                    (hr, hi)
+                }
+            };
+            row_index.push(idx);
+        }
+        let rows = row_kernels.iter().map(|_| Plane::default()).collect();
         let zeroed = vec![[false; 4]; angles.len()];
         Self {
             cfg: cfg.clone(),
@@ -152,8 +176,9 @@ impl GaborBank {
             ones: vec![1.0; n],
             scratch: FilterScratch::default(),
             box_: Plane::default(),
-            hr: Plane::default(),
-            hi: Plane::default(),
+            row_kernels,
+            row_index,
+            rows,
             parts,
             zeroed,
         }
@@ -176,32 +201,44 @@ impl GaborBank {
             GaborBorder::Zero | GaborBorder::StbCompat => Border::Zero,
         };
         let s = &mut self.scratch;
-        sep_filter(backend, src, &mut self.box_, &self.ones, &self.ones, border, s)?;
+        // Every row pass reads `src`: one bank (up to eight kernels at a time, from a list on
+        // the stack, so that a frame allocates nothing).
+        let n_rows = self.row_kernels.len();
+        let mut start = 0;
+        while start < n_rows {
+            let end = (start + 8).min(n_rows);
+            let mut ks: [&[f32]; 8] = [&[]; 8];
+            for (slot, k) in ks.iter_mut().zip(&self.row_kernels[start..end]) {
+                *slot = k;
+            }
+            filter_rows_bank(backend, src, &ks[..end - start], &mut self.rows[start..end], border, s)?;
+            start = end;
+        }
+        filter_cols(backend, &self.rows[0], &mut self.box_, &self.ones, border, s)?;
         for a in 0..self.angles.len() {
             let f = &self.angles[a];
             // theta' = 180 - theta: Hi flips sign and v is shared, so a mirror angle reuses its
             // original's parts with the signs of B and D flipped (see energy_row).
             if f.mirror_of.is_none() {
-                filter_rows(backend, src, &mut self.hr, &f.hr, border, s)?;
-                if let Some(hi) = &f.hi {
-                    filter_rows(backend, src, &mut self.hi, hi, border, s)?;
-                }
+                let (hr, hi) = self.row_index[a];
+                let hr = &self.rows[hr];
+                let hi = hi.map(|i| &self.rows[i]);
                 let (p, z) = (&mut self.parts[a], &mut self.zeroed[a]);
-                filter_cols(backend, &self.hr, &mut p[0], &f.vr, border, s)?;
-                match (&f.hi, &f.vi) {
-                    (Some(_), Some(vi)) => {
-                        filter_cols(backend, &self.hi, &mut p[1], vi, border, s)?;
-                        filter_cols(backend, &self.hr, &mut p[2], vi, border, s)?;
-                        filter_cols(backend, &self.hi, &mut p[3], &f.vr, border, s)?;
+                filter_cols(backend, hr, &mut p[0], &f.vr, border, s)?;
+                match (hi, &f.vi) {
+                    (Some(hi), Some(vi)) => {
+                        filter_cols(backend, hi, &mut p[1], vi, border, s)?;
+                        filter_cols(backend, hr, &mut p[2], vi, border, s)?;
+                        filter_cols(backend, hi, &mut p[3], &f.vr, border, s)?;
                     }
-                    (Some(_), None) => {
+                    (Some(hi), None) => {
                         zero_like(&mut p[1], src, &mut z[1]);
                         zero_like(&mut p[2], src, &mut z[2]);
-                        filter_cols(backend, &self.hi, &mut p[3], &f.vr, border, s)?;
+                        filter_cols(backend, hi, &mut p[3], &f.vr, border, s)?;
                     }
                     (None, Some(vi)) => {
                         zero_like(&mut p[1], src, &mut z[1]);
-                        filter_cols(backend, &self.hr, &mut p[2], vi, border, s)?;
+                        filter_cols(backend, hr, &mut p[2], vi, border, s)?;
                         zero_like(&mut p[3], src, &mut z[3]);
                     }
                     (None, None) => {

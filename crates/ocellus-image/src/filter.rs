@@ -436,7 +436,9 @@ dispatch_kernel!(fn filter_cols_kernel => filter_cols_generic(
 ));
 
 #[cfg(target_arch = "x86_64")]
+mod bank;
 mod column_pairs;
+pub use bank::filter_rows_bank;
 #[cfg(target_arch = "x86_64")]
 mod x86;
 

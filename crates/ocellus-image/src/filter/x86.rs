@@ -380,3 +380,157 @@ unsafe fn folded_vectors<const L: usize>(
         }
     }
 }
+
+/// Most kernels [`bank_rows_avx512`] filters a row with at once.
+pub(super) const BANK_MAX: usize = 8;
+
+/// Every row of `src` through each of the kernels `ks` (all of one odd length, half-width at
+/// most [`FOLDED_512_MAX_HALF`]; those at the indices `even` even-symmetric, those at `odd`
+/// odd-symmetric) into the plane of `dsts` at the same index (already `src`'s size), padded
+/// by `border`: what [`correlate_folded_avx512`] gives for each kernel alone, bit for bit,
+/// from one pass over the row. Why: the shifted vectors (two `valignd` per tap) and the pair
+/// sums and differences are the same for every kernel of a bank that filters one input, so
+/// they are cut once for all of them instead of once per kernel; the Gabor bank's six row
+/// passes become one. The parities are type parameters so that each tap's multiply-add
+/// takes its sum or difference without a run-time choice. False (nothing written) when the
+/// sizes or kernels do not fit.
+///
+/// # Safety
+/// The CPU must have AVX-512 F (and AVX2, FMA).
+#[target_feature(enable = "avx512f,avx2,fma")]
+pub(super) unsafe fn bank_rows_avx512<const E: usize, const O: usize>(
+    src: &Plane<f32>,
+    ks: &[&[f32]],
+    (even, odd): (&[usize], &[usize]),
+    dsts: &mut [Plane<f32>],
+    border: super::Border,
+    padded: &mut Vec<f32>,
+) -> bool {
+    let (w, h_img) = src.size();
+    let Some(len) = ks.first().map(|k| k.len()) else { return false };
+    let h = len / 2;
+    let n = ks.len();
+    if even.len() != E
+        || odd.len() != O
+        || dsts.len() != n
+        || even.iter().chain(odd).any(|&i| i >= n)
+        || (0..n).any(|i| even.iter().chain(odd).filter(|&&j| j == i).count() != 1)
+        || w < 8
+        || len.is_multiple_of(2)
+        || h > FOLDED_512_MAX_HALF
+        || ks.iter().any(|k| k.len() != len)
+        || dsts.iter().any(|d| d.size() != (w, h_img))
+    {
+        return false;
+    }
+    // Taps per kernel, the centre first.
+    let tap_table = |k: &[f32]| {
+        let mut t = [0f32; FOLDED_512_MAX_HALF + 1];
+        t[..=h].copy_from_slice(&k[h..]);
+        t
+    };
+    let we: [[f32; FOLDED_512_MAX_HALF + 1]; E] = std::array::from_fn(|i| tap_table(ks[even[i]]));
+    let wo: [[f32; FOLDED_512_MAX_HALF + 1]; O] = std::array::from_fn(|i| tap_table(ks[odd[i]]));
+    // The padded row placed as `rows_pass` places it: output 0's centre on a cache line.
+    padded.resize(w + 2 * h + 96, 0.0);
+    let first = padded.as_ptr() as usize / 4 + h;
+    let start = 16 + (16 - first % 16) % 16;
+    let nv = w.div_ceil(16);
+    if padded.len() < start + h + nv * 16 + 32 {
+        return false;
+    }
+    for y in 0..h_img {
+        super::pad_into(src.row(y), h, border, &mut padded[start..start + w + 2 * h]);
+        let c = padded.as_ptr().wrapping_add(start + h);
+        // Distinct planes (each index once, checked above), so the rows do not alias.
+        let oe: [*mut f32; E] = std::array::from_fn(|i| dsts[even[i]].row_mut(y).as_mut_ptr());
+        let oo: [*mut f32; O] = std::array::from_fn(|i| dsts[odd[i]].row_mut(y).as_mut_ptr());
+        for v in 0..nv {
+            // SAFETY: vector v reads padded[start + h + 16 (v - 1) .. start + h + 16 (v + 2)],
+            // inside the buffer (checked above); stores write the rows' [16 v, w) masked.
+            unsafe { bank_vector::<E, O>(c, (&oe, &oo), v, w, (&we, &wo), h) };
+        }
+    }
+    true
+}
+
+/// Output vector `v` of every kernel of [`bank_rows_avx512`], each as
+/// [`folded_vectors`] computes it: `w[0] c + sum_t w[t] (c[+t] ± c[-t])` (the centre term
+/// left out for an odd kernel), taps in the same order.
+#[allow(clippy::type_complexity)]
+#[inline(always)]
+unsafe fn bank_vector<const E: usize, const O: usize>(
+    c: *const f32,
+    (oe, oo): (&[*mut f32; E], &[*mut f32; O]),
+    v: usize,
+    n: usize,
+    (we, wo): (&[[f32; FOLDED_512_MAX_HALF + 1]; E], &[[f32; FOLDED_512_MAX_HALF + 1]; O]),
+    h: usize,
+) {
+    // SAFETY: the caller keeps the three aligned vectors inside the buffer and the stores
+    // inside the rows.
+    unsafe {
+        let x = 16 * v;
+        let m = _mm512_load_ps(c.add(x).sub(16));
+        let a = _mm512_load_ps(c.add(x));
+        let b = _mm512_load_ps(c.add(x + 16));
+        let mut ae: [__m512; E] = std::array::from_fn(|k| _mm512_mul_ps(_mm512_set1_ps(we[k][0]), a));
+        let mut ao = [_mm512_setzero_ps(); O];
+        macro_rules! tap {
+            ($t:literal) => {
+                if $t <= h {
+                    let sp =
+                        _mm512_castsi512_ps(_mm512_alignr_epi32::<$t>(_mm512_castps_si512(b), _mm512_castps_si512(a)));
+                    let sm = _mm512_castsi512_ps(_mm512_alignr_epi32::<{ 16 - $t }>(
+                        _mm512_castps_si512(a),
+                        _mm512_castps_si512(m),
+                    ));
+                    if E > 0 {
+                        let s = _mm512_add_ps(sp, sm);
+                        for k in 0..E {
+                            ae[k] = _mm512_fmadd_ps(_mm512_set1_ps(we[k][$t]), s, ae[k]);
+                        }
+                    }
+                    if O > 0 {
+                        let d = _mm512_sub_ps(sp, sm);
+                        for k in 0..O {
+                            ao[k] = _mm512_fmadd_ps(_mm512_set1_ps(wo[k][$t]), d, ao[k]);
+                        }
+                    }
+                }
+            };
+        }
+        tap!(1);
+        tap!(2);
+        tap!(3);
+        tap!(4);
+        tap!(5);
+        tap!(6);
+        tap!(7);
+        tap!(8);
+        tap!(9);
+        tap!(10);
+        tap!(11);
+        tap!(12);
+        tap!(13);
+        tap!(14);
+        tap!(15);
+        if h >= 16 {
+            let (s, d) = (_mm512_add_ps(b, m), _mm512_sub_ps(b, m));
+            for k in 0..E {
+                ae[k] = _mm512_fmadd_ps(_mm512_set1_ps(we[k][16]), s, ae[k]);
+            }
+            for k in 0..O {
+                ao[k] = _mm512_fmadd_ps(_mm512_set1_ps(wo[k][16]), d, ao[k]);
+            }
+        }
+        let left = n - x;
+        let mask = if left >= 16 { !0u16 } else { (1u16 << left) - 1 };
+        for k in 0..E {
+            _mm512_mask_storeu_ps(oe[k].add(x), mask, ae[k]);
+        }
+        for k in 0..O {
+            _mm512_mask_storeu_ps(oo[k].add(x), mask, ao[k]);
+        }
+    }
+}
