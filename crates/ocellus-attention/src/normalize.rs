@@ -3,7 +3,7 @@
 
 use crate::config::{GlobalInhibition, Normalization};
 use crate::Result;
-use ocellus_image::preserving::{Lanes, PreservingFilter};
+use ocellus_image::preserving::{dog_step_lanes, Lanes, PreservingFilter};
 use ocellus_image::simd::Madd;
 use ocellus_image::{dispatch_kernel, Backend, Plane};
 
@@ -182,13 +182,12 @@ impl Normalizer {
         }
         let (Some(ex), Some(inh)) = (self.excitation.as_mut(), self.inhibition.as_mut()) else { return Ok(()) };
         for _ in 0..iterations {
-            ex.apply_lanes(backend, maps, &mut self.excit_lanes)?;
-            inh.apply_lanes(backend, maps, &mut self.inhib_lanes)?;
+            // The filters leave `maps` as it is, so its maximum may be taken first.
             let c: Lanes = match global_inhibition {
                 GlobalInhibition::Constant(c) => [c; 8],
                 GlobalInhibition::RelativeToMax(f) => lanes_min_max(backend, maps).1.map(|m| f * m),
             };
-            compete_lanes(backend, maps, &self.excit_lanes, &self.inhib_lanes, c);
+            dog_step_lanes(backend, ex, inh, maps, (&mut self.excit_lanes, &mut self.inhib_lanes), c)?;
         }
         Ok(())
     }
@@ -237,27 +236,6 @@ fn lanes_affine_generic<M: Madd>(maps: &mut Plane<Lanes>, scale: Lanes, offset: 
 
 dispatch_kernel!(fn lanes_affine => lanes_affine_generic(maps: &mut Plane<Lanes>, scale: Lanes, offset: Lanes));
 
-/// One competition step per lane: `M <- max(0, M + E - I - c)`.
-#[inline(always)]
-#[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
-fn compete_lanes_generic<M: Madd>(maps: &mut Plane<Lanes>, excit: &Plane<Lanes>, inhib: &Plane<Lanes>, c: Lanes) {
-    #[cfg(target_arch = "x86_64")]
-    if M::AVX512 {
-        // SAFETY: as in `lanes_min_max_generic`.
-        return unsafe { x86::compete_lanes(maps, excit, inhib, &c) };
-    }
-    for y in 0..maps.height() {
-        let (e, i) = (excit.row(y), inhib.row(y));
-        for ((p, ev), iv) in maps.row_mut(y).iter_mut().zip(e).zip(i) {
-            for l in 0..8 {
-                p[l] = (p[l] + ev[l] - iv[l] - c[l]).max(0.0);
-            }
-        }
-    }
-}
-
-dispatch_kernel!(fn compete_lanes => compete_lanes_generic(maps: &mut Plane<Lanes>, excit: &Plane<Lanes>, inhib: &Plane<Lanes>, c: Lanes));
-
 /// Itti et al. 1998: multiply by `(M - mean of local maxima)^2`, M the range's top (or the
 /// map maximum without a range). Local maxima: interior pixels not below their 4 neighbours
 /// nor below a tenth of the range (SaliencyToolbox `maxNormalizeLocalMax`). With one maximum
@@ -300,7 +278,7 @@ fn local_max(map: &mut Plane<f32>, range: Option<f32>) {
 mod tests {
     use super::*;
 
-    /// The AVX-512 forms of the per-pixel steps give the generic kernels' results bit for bit,
+    /// The AVX-512 min/max and affine steps give the generic kernels' results bit for bit,
     /// on widths with and without an odd last pixel.
     #[cfg(target_arch = "x86_64")]
     #[test]
@@ -317,7 +295,7 @@ mod tests {
             let mut map = || -> Plane<Lanes> {
                 Plane::from_fn(w, h, |_, _| std::array::from_fn(|_| rng.unit() as f32 * 4.0 - 1.0))
             };
-            let (m, e, i) = (map(), map(), map());
+            let m = map();
             let c: Lanes = std::array::from_fn(|l| 0.1 * l as f32);
             let s: Lanes = std::array::from_fn(|l| 1.0 + 0.37 * l as f32);
             // SAFETY: AVX-512 was checked above.
@@ -328,11 +306,6 @@ mod tests {
             // SAFETY: as above.
             unsafe { x86::lanes_affine(&mut b, &s, &c) };
             assert_eq!(bits(&a), bits(&b), "{w}x{h} affine");
-            let (mut a, mut b) = (m.clone(), m.clone());
-            compete_lanes_generic::<Fused>(&mut a, &e, &i, c);
-            // SAFETY: as above.
-            unsafe { x86::compete_lanes(&mut b, &e, &i, &c) };
-            assert_eq!(bits(&a), bits(&b), "{w}x{h} compete");
         }
     }
 }

@@ -247,6 +247,9 @@ fn preserving_lanes_generic<M: Madd>(
     }
 }
 
+mod dog;
+pub use dog::dog_step_lanes;
+
 #[cfg(target_arch = "x86_64")]
 mod x86;
 

@@ -1,8 +1,9 @@
 //! AVX-512 forms of N(.)'s per-pixel steps on eight interleaved maps.
 //!
 //! Why by hand: on `[f32; 8]` pixels LLVM vectorized these loops across pixels, one lane at
-//! a time with gathers and scatters (or at 256 bits), so that three trivial passes over a
-//! 40 x 30 map cost as much as a 5-tap filter. Here two pixels (16 floats, lane `i % 8`) are
+//! a time with gathers and scatters (or at 256 bits), so that trivial passes over a 40 x 30
+//! map cost as much as a 5-tap filter. (The competition step is fused into the filters:
+//! `ocellus_image::preserving::dog_step_lanes`.) Here two pixels (16 floats, lane `i % 8`) are
 //! one 512-bit register. Each value is computed with the generic kernel's operations in its
 //! order, so the results are the same bit for bit (tested).
 
@@ -73,38 +74,6 @@ pub(super) unsafe fn lanes_affine(maps: &mut Plane<Lanes>, scale: &Lanes, offset
         for p in rest {
             for l in 0..8 {
                 p[l] = p[l].max(0.0).mul_add(scale[l], offset[l]);
-            }
-        }
-    }
-}
-
-/// `M <- max(0, M + E - I - c)` per lane, as `compete_lanes_generic`.
-///
-/// # Safety
-/// The CPU must have AVX-512 F and DQ.
-#[target_feature(enable = "avx512f,avx512dq,avx2")]
-pub(super) unsafe fn compete_lanes(maps: &mut Plane<Lanes>, excit: &Plane<Lanes>, inhib: &Plane<Lanes>, c: &Lanes) {
-    // SAFETY: the features were promised by the caller.
-    let (cv, z) = unsafe { (twice(c), _mm512_setzero_ps()) };
-    for y in 0..maps.height() {
-        let (e, i) = (excit.row(y).as_chunks::<2>(), inhib.row(y).as_chunks::<2>());
-        let (pairs, rest) = maps.row_mut(y).as_chunks_mut::<2>();
-        for ((p, ev), iv) in pairs.iter_mut().zip(e.0).zip(i.0) {
-            let q = p.as_mut_ptr() as *mut f32;
-            // SAFETY: each of `p`, `ev`, `iv` is 16 contiguous floats.
-            unsafe {
-                let (m, ev, iv) = (
-                    _mm512_loadu_ps(q),
-                    _mm512_loadu_ps(ev.as_ptr() as *const f32),
-                    _mm512_loadu_ps(iv.as_ptr() as *const f32),
-                );
-                let v = _mm512_sub_ps(_mm512_sub_ps(_mm512_add_ps(m, ev), iv), cv);
-                _mm512_storeu_ps(q, _mm512_max_ps(v, z));
-            }
-        }
-        for ((p, ev), iv) in rest.iter_mut().zip(e.1).zip(i.1) {
-            for l in 0..8 {
-                p[l] = (p[l] + ev[l] - iv[l] - c[l]).max(0.0);
             }
         }
     }

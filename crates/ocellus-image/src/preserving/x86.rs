@@ -112,6 +112,29 @@ impl WideScratch {
             }
         }
     }
+
+    /// [`Self::load_row_avx512`], then the pairs from odd pixels (`odd`) from those from even
+    /// ones. Does nothing unless `odd` is one pair shorter than `even`.
+    ///
+    /// # Safety
+    /// The CPU must have AVX-512 F.
+    #[target_feature(enable = "avx512f,avx2")]
+    unsafe fn load_pairs_avx512(&mut self, row: &[Lanes]) {
+        if self.odd.len() + 1 != self.even.len() {
+            return;
+        }
+        // SAFETY: AVX-512 F was promised by the caller; the pairs read and written lie in
+        // `even` and `odd` (their lengths checked above).
+        unsafe {
+            self.load_row_avx512(row);
+            let e = self.even.as_ptr() as *const __m512;
+            // Pixels (2q + 1, 2q + 2): the high half of pair q, the low half of pair q + 1.
+            for (q, o) in self.odd.iter_mut().enumerate() {
+                let v = _mm512_shuffle_f32x4::<0x4E>(_mm512_load_ps(e.add(q) as _), _mm512_load_ps(e.add(q + 1) as _));
+                _mm512_store_ps(o.0.as_mut_ptr(), v);
+            }
+        }
+    }
 }
 
 /// The energy-preserving filter of eight interleaved maps, as `preserving_lanes_generic`:
@@ -137,17 +160,9 @@ pub(super) unsafe fn preserving_lanes_avx512(
     }
     let wp = 2 * npair;
     for y in 0..h {
-        // SAFETY: AVX-512 F was promised by the caller.
-        unsafe { s.load_row_avx512(src.row(y)) };
-        // SAFETY: the pairs read and written lie in `even` and `odd` (checked above).
-        unsafe {
-            let e = s.even.as_ptr() as *const __m512;
-            // Pixels (2q + 1, 2q + 2): the high half of pair q, the low half of pair q + 1.
-            for (q, o) in s.odd.iter_mut().enumerate() {
-                let v = _mm512_shuffle_f32x4::<0x4E>(_mm512_load_ps(e.add(q) as _), _mm512_load_ps(e.add(q + 1) as _));
-                _mm512_store_ps(o.0.as_mut_ptr(), v);
-            }
-        }
+        // SAFETY: AVX-512 F was promised by the caller; `odd` is one pair shorter than `even`
+        // (checked above).
+        unsafe { s.load_pairs_avx512(src.row(y)) };
         let out = &mut s.tmp[y * npair..(y + 1) * npair];
         for (x0, p) in blocks(wp) {
             // SAFETY: x0 + 2 P <= wp, so the pairs read lie below (wp + hw + off) / 2 + 1
@@ -186,6 +201,180 @@ pub(super) unsafe fn preserving_lanes_avx512(
         y += 2;
     }
     true
+}
+
+/// A lane vector repeated over two pixels.
+#[inline(always)]
+unsafe fn twice(v: &Lanes) -> __m512 {
+    // SAFETY: `v` holds 8 floats; the caller has AVX-512 F.
+    unsafe {
+        let h = _mm256_loadu_ps(v.as_ptr());
+        _mm512_insertf32x8::<1>(_mm512_castps256_ps512(h), h)
+    }
+}
+
+/// `M <- max(0, M + E - I - c)` per lane, as `compete_lanes_generic` (two pixels per
+/// 512-bit register: on `[f32; 8]` pixels LLVM vectorized the loop across pixels, one lane at
+/// a time with gathers and scatters).
+///
+/// # Safety
+/// The CPU must have AVX-512 F and DQ.
+#[target_feature(enable = "avx512f,avx512dq,avx2")]
+pub(super) unsafe fn compete_lanes(maps: &mut Plane<Lanes>, excit: &Plane<Lanes>, inhib: &Plane<Lanes>, c: &Lanes) {
+    // SAFETY: the features were promised by the caller.
+    let (cv, z) = unsafe { (twice(c), _mm512_setzero_ps()) };
+    for y in 0..maps.height() {
+        let (e, i) = (excit.row(y).as_chunks::<2>(), inhib.row(y).as_chunks::<2>());
+        let (pairs, rest) = maps.row_mut(y).as_chunks_mut::<2>();
+        for ((p, ev), iv) in pairs.iter_mut().zip(e.0).zip(i.0) {
+            let q = p.as_mut_ptr() as *mut f32;
+            // SAFETY: each of `p`, `ev`, `iv` is 16 contiguous floats.
+            unsafe {
+                let (ev, iv) = (_mm512_loadu_ps(ev.as_ptr() as *const f32), _mm512_loadu_ps(iv.as_ptr() as *const f32));
+                _mm512_storeu_ps(q, compete_vector(_mm512_loadu_ps(q), ev, iv, cv, z));
+            }
+        }
+        for ((p, ev), iv) in rest.iter_mut().zip(e.1).zip(i.1) {
+            for l in 0..8 {
+                p[l] = (p[l] + ev[l] - iv[l] - c[l]).max(0.0);
+            }
+        }
+    }
+}
+
+/// `max(0, m + e - i - c)`, the operations of `compete_lanes_generic` in its order.
+#[inline(always)]
+unsafe fn compete_vector(m: __m512, e: __m512, i: __m512, c: __m512, z: __m512) -> __m512 {
+    // SAFETY: the caller has AVX-512 F.
+    unsafe { _mm512_max_ps(_mm512_sub_ps(_mm512_sub_ps(_mm512_add_ps(m, e), i), c), z) }
+}
+
+/// One step of the iterative difference of Gaussians on eight interleaved maps, fused:
+/// `maps <- max(0, maps + E - I - c)` with `E` and `I` the excitatory and inhibitory
+/// energy-preserving filters of `maps` (kernels `ke`, `ki`, vertical taps `re`, `ri`, buffers
+/// `se`, `si`), each output as [`preserving_lanes_avx512`] and [`compete_lanes`] compute
+/// it, bit for bit. Why: apart, the two filters each copy every row and build its odd pairs,
+/// write their results, and the competition reads them back; fused, the row is prepared once
+/// (the excitatory kernel, the shorter, reads the inhibitory one's padded pairs), and the
+/// competition takes both sums from registers. False (nothing written) where the buffers do
+/// not fit or the excitatory kernel is the longer.
+///
+/// # Safety
+/// The CPU must have AVX-512 F and DQ (and AVX2 + FMA).
+#[allow(clippy::type_complexity)]
+#[target_feature(enable = "avx512f,avx512dq,avx2,fma")]
+pub(super) unsafe fn dog_step_avx512(
+    (ke, re, se): (&[f32], &[Vec<(usize, f32)>], &mut WideScratch),
+    (ki, ri, si): (&[f32], &[Vec<(usize, f32)>], &mut WideScratch),
+    maps: &mut Plane<Lanes>,
+    c: &Lanes,
+) -> bool {
+    let (w, h) = maps.size();
+    let Some((first_i, npair)) = si.fits(ki, ri, maps, maps) else { return false };
+    let Some((_, npair_e)) = se.fits(ke, re, maps, maps) else { return false };
+    let (hw_e, hw_i) = ((ke.len() - 1) / 2, (ki.len() - 1) / 2);
+    if w < 2 || si.odd.len() + 1 != si.even.len() || hw_e > hw_i || npair_e != npair {
+        return false;
+    }
+    // The excitatory taps read the inhibitory buffers: pixel x sits at x + si.off there, and
+    // its reach (hw_e <= hw_i) stays inside what `si.fits` checked.
+    let first_e = si.off - hw_e;
+    let wp = 2 * npair;
+    for y in 0..h {
+        // SAFETY: AVX-512 F was promised by the caller; `odd` is one pair shorter (checked).
+        unsafe { si.load_pairs_avx512(maps.row(y)) };
+        let (oi, oe) = (&mut si.tmp[y * npair..(y + 1) * npair], &mut se.tmp[y * npair..(y + 1) * npair]);
+        for (x0, p) in blocks(wp) {
+            // SAFETY: as in `preserving_lanes_avx512`, for both kernels.
+            unsafe {
+                match p {
+                    8 => {
+                        row_block::<8>(&si.even, &si.odd, first_i, ki, &si.fx_pairs, oi, x0);
+                        row_block::<8>(&si.even, &si.odd, first_e, ke, &se.fx_pairs, oe, x0);
+                    }
+                    4 => {
+                        row_block::<4>(&si.even, &si.odd, first_i, ki, &si.fx_pairs, oi, x0);
+                        row_block::<4>(&si.even, &si.odd, first_e, ke, &se.fx_pairs, oe, x0);
+                    }
+                    _ => {
+                        row_block::<1>(&si.even, &si.odd, first_i, ki, &si.fx_pairs, oi, x0);
+                        row_block::<1>(&si.even, &si.odd, first_e, ke, &se.fx_pairs, oe, x0);
+                    }
+                }
+            }
+        }
+    }
+    let (te, ti) = (se.tmp.as_ptr() as *const f32, si.tmp.as_ptr() as *const f32);
+    let stride = npair * 16;
+    // SAFETY: the features were promised by the caller.
+    let (cv, z) = unsafe { (twice(c), _mm512_setzero_ps()) };
+    let mut y = 0;
+    while y < h {
+        let two = y + 1 < h;
+        let rows =
+            [maps.row_mut(y).as_mut_ptr() as *mut f32, maps.row_mut((y + 1).min(h - 1)).as_mut_ptr() as *mut f32];
+        let (tap_e, tap_i) = ([&re[y][..], &re[(y + 1).min(h - 1)][..]], [&ri[y][..], &ri[(y + 1).min(h - 1)][..]]);
+        // Pixels below `from` are done: the last block may start inside the one before it,
+        // and a competition must not run twice on a pixel.
+        let mut from = 0;
+        for (x0, p) in blocks(w) {
+            let args = Epilogue { rows, n_rows: if two { 2 } else { 1 }, x0, from, c: cv, z };
+            // SAFETY: every tap's row is below h (checked above) and x0 + 2 P <= w.
+            unsafe {
+                match p {
+                    8 => dog_block::<8>(te, ti, stride, tap_e, tap_i, &args),
+                    4 => dog_block::<4>(te, ti, stride, tap_e, tap_i, &args),
+                    _ => dog_block::<1>(te, ti, stride, tap_e, tap_i, &args),
+                }
+            }
+            from = x0 + 2 * p;
+        }
+        y += 2;
+    }
+    true
+}
+
+/// Where [`dog_block`] writes: the map rows (one or two), the block's first pixel, the
+/// first pixel not yet done, and the constant and zero vectors.
+struct Epilogue {
+    rows: [*mut f32; 2],
+    n_rows: usize,
+    x0: usize,
+    from: usize,
+    c: __m512,
+    z: __m512,
+}
+
+/// `2 P` pixels from `x0` of one or two map rows: both vertical sums ([`col_sums2`] or
+/// [`col_sums`], as the separate filter takes them), then the competition in place on the
+/// pixels from `from` on.
+#[inline(always)]
+unsafe fn dog_block<const P: usize>(
+    te: *const f32,
+    ti: *const f32,
+    stride: usize,
+    tap_e: [&[(usize, f32)]; 2],
+    tap_i: [&[(usize, f32)]; 2],
+    g: &Epilogue,
+) {
+    // SAFETY: the caller keeps [x0, x0 + 2 P) within the rows and every tap row below h.
+    unsafe {
+        let (e, i) = if g.n_rows == 2 {
+            (col_sums2::<P>(te, stride, tap_e, g.x0), col_sums2::<P>(ti, stride, tap_i, g.x0))
+        } else {
+            let (e, i) = (col_sums::<P>(te, stride, tap_e[0], g.x0), col_sums::<P>(ti, stride, tap_i[0], g.x0));
+            ([e, e], [i, i])
+        };
+        for r in 0..g.n_rows {
+            for k in 0..P {
+                let px = g.x0 + 2 * k;
+                let mask = (if px >= g.from { 0x00FFu16 } else { 0 }) | (if px + 1 >= g.from { 0xFF00 } else { 0 });
+                let q = g.rows[r].add(px * 8);
+                let m = _mm512_maskz_loadu_ps(mask, q);
+                _mm512_mask_storeu_ps(q, mask, compete_vector(m, e[r][k], i[r][k], g.c, g.z));
+            }
+        }
+    }
 }
 
 /// The blocks `(x0, pairs)` covering [0, w) (w >= 2): 8 pairs of pixels while they fit, then
@@ -249,6 +438,18 @@ unsafe fn row_block<const P: usize>(
 unsafe fn col_block<const P: usize>(tmp: *const f32, stride: usize, taps: &[(usize, f32)], out: *mut f32, x0: usize) {
     // SAFETY: the caller keeps [x0, x0 + 2 P) within the rows and every r_i < height.
     unsafe {
+        let a = col_sums::<P>(tmp, stride, taps, x0);
+        for (j, a) in a.iter().enumerate() {
+            _mm512_storeu_ps(out.add((x0 + 2 * j) * 8), *a);
+        }
+    }
+}
+
+/// The sums of [`col_block`], in registers.
+#[inline(always)]
+unsafe fn col_sums<const P: usize>(tmp: *const f32, stride: usize, taps: &[(usize, f32)], x0: usize) -> [__m512; P] {
+    // SAFETY: the caller keeps [x0, x0 + 2 P) within the rows and every r_i < height.
+    unsafe {
         let mut a = [_mm512_setzero_ps(); P];
         for &(r, wt) in taps {
             let s = tmp.add(r * stride + x0 * 8);
@@ -257,9 +458,7 @@ unsafe fn col_block<const P: usize>(tmp: *const f32, stride: usize, taps: &[(usi
                 *a = _mm512_fmadd_ps(wv, _mm512_loadu_ps(s.add(16 * j)), *a);
             }
         }
-        for (j, a) in a.iter().enumerate() {
-            _mm512_storeu_ps(out.add((x0 + 2 * j) * 8), *a);
-        }
+        a
     }
 }
 
@@ -275,6 +474,25 @@ unsafe fn col_block2<const P: usize>(
     out: [*mut f32; 2],
     x0: usize,
 ) {
+    // SAFETY: the caller keeps [x0, x0 + 2 P) within the rows and every r_i < height.
+    unsafe {
+        let a = col_sums2::<P>(tmp, stride, taps, x0);
+        for (o, a) in out.iter().zip(&a) {
+            for (k, a) in a.iter().enumerate() {
+                _mm512_storeu_ps(o.add((x0 + 2 * k) * 8), *a);
+            }
+        }
+    }
+}
+
+/// The sums of [`col_block2`], in registers.
+#[inline(always)]
+unsafe fn col_sums2<const P: usize>(
+    tmp: *const f32,
+    stride: usize,
+    taps: [&[(usize, f32)]; 2],
+    x0: usize,
+) -> [[__m512; P]; 2] {
     // SAFETY: the caller keeps [x0, x0 + 2 P) within the rows and every r_i < height.
     unsafe {
         let mut a = [[_mm512_setzero_ps(); P]; 2];
@@ -308,11 +526,7 @@ unsafe fn col_block2<const P: usize>(
                 j += 1;
             }
         }
-        for (o, a) in out.iter().zip(&a) {
-            for (k, a) in a.iter().enumerate() {
-                _mm512_storeu_ps(o.add((x0 + 2 * k) * 8), *a);
-            }
-        }
+        a
     }
 }
 
