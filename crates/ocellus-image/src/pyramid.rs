@@ -430,7 +430,15 @@ fn pyr_down_rgb8_generic<M: Madd>(
             // the samples are split into even/odd per channel.
             let mut d = d_inner;
             taps_at(j, inner, &s.itaps_interior, &mut s.itaps, |t| d = ik.taps_for(kernel, j, h, &mut s.taps, t));
-            vertical_bytes_u16(src, &s.itaps, &mut s.row16);
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512 (F/BW/VL/DQ),
+            // which `dispatch_kernel!` calls only on CPUs that have it.
+            let done = M::AVX512 && unsafe { x86::vertical_bytes_u16_avx512(src, &s.itaps, &mut s.row16) };
+            #[cfg(not(target_arch = "x86_64"))]
+            let done = false;
+            if !done {
+                vertical_bytes_u16(src, &s.itaps, &mut s.row16);
+            }
             split_even_odd(&s.row16, 1.0 / (d as f32 * 255.0), [e0, e1, e2], [o0, o1, o2]);
         } else {
             vertical_bytes::<M>(src, j, h, kernel, &mut s.taps, &mut s.row3);
@@ -523,6 +531,9 @@ impl IntegerTaps {
         out.iter().map(|&(_, k)| k as u32).sum::<u32>().max(1)
     }
 }
+
+#[cfg(target_arch = "x86_64")]
+mod x86;
 
 /// `out[x] = sum_taps n * byte[x]` over the interleaved bytes of the rows in `taps` (at
 /// most [`MAX_TAPS`]; sums of at most 255 * 256: no overflow), 64 values at a time.
