@@ -164,11 +164,12 @@ pub(super) unsafe fn preserving_lanes_avx512(
         // (checked above).
         unsafe { s.load_pairs_avx512(src.row(y)) };
         let out = &mut s.tmp[y * npair..(y + 1) * npair];
-        for (x0, p) in blocks(wp) {
+        for (x0, p) in blocks_up_to(wp, 10) {
             // SAFETY: x0 + 2 P <= wp, so the pairs read lie below (wp + hw + off) / 2 + 1
             // (checked above) and those written below npair.
             unsafe {
                 match p {
+                    10 => row_block::<10>(&s.even, &s.odd, first, k, &s.fx_pairs, out, x0),
                     8 => row_block::<8>(&s.even, &s.odd, first, k, &s.fx_pairs, out, x0),
                     4 => row_block::<4>(&s.even, &s.odd, first, k, &s.fx_pairs, out, x0),
                     _ => row_block::<1>(&s.even, &s.odd, first, k, &s.fx_pairs, out, x0),
@@ -284,10 +285,14 @@ pub(super) unsafe fn dog_step_avx512(
         // SAFETY: AVX-512 F was promised by the caller; `odd` is one pair shorter (checked).
         unsafe { si.load_pairs_avx512(maps.row(y)) };
         let (oi, oe) = (&mut si.tmp[y * npair..(y + 1) * npair], &mut se.tmp[y * npair..(y + 1) * npair]);
-        for (x0, p) in blocks(wp) {
+        for (x0, p) in blocks_up_to(wp, 10) {
             // SAFETY: as in `preserving_lanes_avx512`, for both kernels.
             unsafe {
                 match p {
+                    10 => {
+                        row_block::<10>(&si.even, &si.odd, first_i, ki, &si.fx_pairs, oi, x0);
+                        row_block::<10>(&si.even, &si.odd, first_e, ke, &se.fx_pairs, oe, x0);
+                    }
                     8 => {
                         row_block::<8>(&si.even, &si.odd, first_i, ki, &si.fx_pairs, oi, x0);
                         row_block::<8>(&si.even, &si.odd, first_e, ke, &se.fx_pairs, oe, x0);
@@ -383,12 +388,23 @@ unsafe fn dog_block<const P: usize>(
 /// kernel's target features.
 #[inline(always)]
 fn blocks(w: usize) -> impl Iterator<Item = (usize, usize)> {
+    blocks_up_to(w, 8)
+}
+
+/// [`blocks`] with blocks of 10 pairs first where `widest` is 10: the horizontal pass's
+/// chains of multiply-adds need 8 in flight to hide their latency, so a 40-pixel row as
+/// 10 + 10 pairs runs at full rate where 8 + 8 + 4 ran its last block at half. (The vertical
+/// pass computes two rows per block, so its 4-pair blocks have 8 chains already.)
+#[inline(always)]
+fn blocks_up_to(w: usize, widest: usize) -> impl Iterator<Item = (usize, usize)> {
     let mut x = 0;
     std::iter::from_fn(move || {
         if x >= w {
             return None;
         }
-        let p = if x + 16 <= w {
+        let p = if widest >= 10 && x + 20 <= w {
+            10
+        } else if x + 16 <= w {
             8
         } else if x + 8 <= w {
             4
