@@ -219,7 +219,14 @@ fn decimate_interior_generic<M: Madd>(even: &[f32], odd: &[f32], k: &[f32], orig
         decimate_chunk::<M, 32>(a, b, plan, j, out);
         j += 32;
     }
-    // 8 at a time, then one 8-wide chunk aligned to the end (recomputes a few outputs).
+    if j < n && n >= 32 {
+        // The rest as one 32-wide chunk aligned to the end (recomputing a few outputs, with
+        // the same values): 8 outputs at a time, each a chain of one multiply-add per tap,
+        // waited on the multiply-add latency and had cost a tenth of a pyramid level.
+        decimate_chunk::<M, 32>(a, b, plan, n - 32, out);
+        j = n;
+    }
+    // Short rows: 8 at a time, then one 8-wide chunk aligned to the end.
     while j < n && n >= 8 {
         let j0 = if j + 8 <= n { j } else { n - 8 };
         let mut acc = [0f32; 8];
