@@ -2,14 +2,17 @@
 //! interleaved maps: the competition of N(.) (SPEC 1.6), `M <- max(0, M + E - I - c)`.
 
 use super::{Lanes, PreservingFilter};
+
+#[cfg(target_arch = "x86_64")]
+mod x86;
 use crate::simd::Madd;
 use crate::{dispatch_kernel, Backend, Plane, Result};
 
 /// `maps <- max(0, maps + E - I - c)` per lane, with `E` and `I` the maps through
 /// `excitation` and `inhibition` (both built for the maps' size; `excit` and `inhib` are
 /// scratch planes). The same values as [`PreservingFilter::apply_lanes`] with each filter
-/// followed by the competition; with AVX-512 the three run as one pass (the row prepared
-/// once for both filters, both sums taken from registers), bit-identical.
+/// followed by the competition; with AVX-512 or AVX2 the three run as one pass (the row
+/// prepared once for both filters, both sums taken from registers), bit-identical.
 pub fn dog_step_lanes(
     backend: Backend,
     excitation: &mut PreservingFilter,
@@ -24,9 +27,17 @@ pub fn dog_step_lanes(
     if backend.resolve() == Backend::Avx512 {
         let (e, i) = (&mut *excitation, &mut *inhibition);
         // SAFETY: `resolve()` returns Avx512 only on CPUs with AVX-512 F/BW/VL/DQ, AVX2 and FMA.
-        let done = unsafe {
-            super::x86::dog_step_avx512((&e.k, &e.rows, &mut e.wide), (&i.k, &i.rows, &mut i.wide), maps, &c)
-        };
+        let done =
+            unsafe { x86::dog_step_avx512((&e.k, &e.rows, &mut e.wide), (&i.k, &i.rows, &mut i.wide), maps, &c) };
+        if done {
+            return Ok(());
+        }
+    }
+    #[cfg(target_arch = "x86_64")]
+    if backend.resolve() == Backend::Avx2 {
+        let (e, i) = (&mut *excitation, &mut *inhibition);
+        // SAFETY: `resolve()` returns Avx2 only on CPUs with AVX2 and FMA.
+        let done = unsafe { x86::dog_step_avx2((&e.k, &e.rows, &mut e.wide), (&i.k, &i.rows, &mut i.wide), maps, &c) };
         if done {
             return Ok(());
         }
@@ -58,7 +69,7 @@ fn compete_lanes_generic<M: Madd>(maps: &mut Plane<Lanes>, excit: &Plane<Lanes>,
     if M::AVX512 {
         // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512, which
         // `dispatch_kernel!` calls only on CPUs that have it.
-        return unsafe { super::x86::compete_lanes(maps, excit, inhib, &c) };
+        return unsafe { x86::compete_lanes(maps, excit, inhib, &c) };
     }
     for y in 0..maps.height() {
         let (e, i) = (excit.row(y), inhib.row(y));
@@ -127,7 +138,7 @@ mod tests {
             let (mut a, mut b) = (m.clone(), m.clone());
             compete_lanes_generic::<crate::simd::Fused>(&mut a, &e, &i, c);
             // SAFETY: AVX-512 was checked above.
-            unsafe { super::super::x86::compete_lanes(&mut b, &e, &i, &c) };
+            unsafe { super::x86::compete_lanes(&mut b, &e, &i, &c) };
             assert_eq!(bits(&a), bits(&b), "{w}x{h}");
         }
     }

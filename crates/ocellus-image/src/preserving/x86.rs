@@ -47,7 +47,7 @@ impl WideScratch {
     /// `rows` (every row below h), `dst` being `src`'s size (the checks that make the
     /// kernels' pointer arithmetic safe): `first` is the padded pixel that tap 0 of output 0
     /// reads, `npair` the pairs per row of `tmp`.
-    fn fits(
+    pub(in crate::preserving) fn fits(
         &self,
         k: &[f32],
         rows: &[Vec<(usize, f32)>],
@@ -72,7 +72,7 @@ impl WideScratch {
     /// Copies one row of the maps into the padded row (`even`), pixel x at `x + off`;
     /// everything else stays zero. Ignores a row longer than the buffer (never, after
     /// [`Self::fits`]).
-    fn load_row(&mut self, row: &[Lanes]) {
+    pub(in crate::preserving) fn load_row(&mut self, row: &[Lanes]) {
         let n = row.len() * 8;
         if (self.off + row.len()) * 8 > self.even.len() * 16 {
             return;
@@ -119,7 +119,7 @@ impl WideScratch {
     /// # Safety
     /// The CPU must have AVX-512 F.
     #[target_feature(enable = "avx512f,avx2")]
-    unsafe fn load_pairs_avx512(&mut self, row: &[Lanes]) {
+    pub(in crate::preserving) unsafe fn load_pairs_avx512(&mut self, row: &[Lanes]) {
         if self.odd.len() + 1 != self.even.len() {
             return;
         }
@@ -204,190 +204,12 @@ pub(super) unsafe fn preserving_lanes_avx512(
     true
 }
 
-/// A lane vector repeated over two pixels.
-#[inline(always)]
-unsafe fn twice(v: &Lanes) -> __m512 {
-    // SAFETY: `v` holds 8 floats; the caller has AVX-512 F.
-    unsafe {
-        let h = _mm256_loadu_ps(v.as_ptr());
-        _mm512_insertf32x8::<1>(_mm512_castps256_ps512(h), h)
-    }
-}
-
-/// `M <- max(0, M + E - I - c)` per lane, as `compete_lanes_generic` (two pixels per
-/// 512-bit register: on `[f32; 8]` pixels LLVM vectorized the loop across pixels, one lane at
-/// a time with gathers and scatters).
-///
-/// # Safety
-/// The CPU must have AVX-512 F and DQ.
-#[target_feature(enable = "avx512f,avx512dq,avx2")]
-pub(super) unsafe fn compete_lanes(maps: &mut Plane<Lanes>, excit: &Plane<Lanes>, inhib: &Plane<Lanes>, c: &Lanes) {
-    // SAFETY: the features were promised by the caller.
-    let (cv, z) = unsafe { (twice(c), _mm512_setzero_ps()) };
-    for y in 0..maps.height() {
-        let (e, i) = (excit.row(y).as_chunks::<2>(), inhib.row(y).as_chunks::<2>());
-        let (pairs, rest) = maps.row_mut(y).as_chunks_mut::<2>();
-        for ((p, ev), iv) in pairs.iter_mut().zip(e.0).zip(i.0) {
-            let q = p.as_mut_ptr() as *mut f32;
-            // SAFETY: each of `p`, `ev`, `iv` is 16 contiguous floats.
-            unsafe {
-                let (ev, iv) = (_mm512_loadu_ps(ev.as_ptr() as *const f32), _mm512_loadu_ps(iv.as_ptr() as *const f32));
-                _mm512_storeu_ps(q, compete_vector(_mm512_loadu_ps(q), ev, iv, cv, z));
-            }
-        }
-        for ((p, ev), iv) in rest.iter_mut().zip(e.1).zip(i.1) {
-            for l in 0..8 {
-                p[l] = (p[l] + ev[l] - iv[l] - c[l]).max(0.0);
-            }
-        }
-    }
-}
-
-/// `max(0, m + e - i - c)`, the operations of `compete_lanes_generic` in its order.
-#[inline(always)]
-unsafe fn compete_vector(m: __m512, e: __m512, i: __m512, c: __m512, z: __m512) -> __m512 {
-    // SAFETY: the caller has AVX-512 F.
-    unsafe { _mm512_max_ps(_mm512_sub_ps(_mm512_sub_ps(_mm512_add_ps(m, e), i), c), z) }
-}
-
-/// One step of the iterative difference of Gaussians on eight interleaved maps, fused:
-/// `maps <- max(0, maps + E - I - c)` with `E` and `I` the excitatory and inhibitory
-/// energy-preserving filters of `maps` (kernels `ke`, `ki`, vertical taps `re`, `ri`, buffers
-/// `se`, `si`), each output as [`preserving_lanes_avx512`] and [`compete_lanes`] compute
-/// it, bit for bit. Why: apart, the two filters each copy every row and build its odd pairs,
-/// write their results, and the competition reads them back; fused, the row is prepared once
-/// (the excitatory kernel, the shorter, reads the inhibitory one's padded pairs), and the
-/// competition takes both sums from registers. False (nothing written) where the buffers do
-/// not fit or the excitatory kernel is the longer.
-///
-/// # Safety
-/// The CPU must have AVX-512 F and DQ (and AVX2 + FMA).
-#[allow(clippy::type_complexity)]
-#[target_feature(enable = "avx512f,avx512dq,avx2,fma")]
-pub(super) unsafe fn dog_step_avx512(
-    (ke, re, se): (&[f32], &[Vec<(usize, f32)>], &mut WideScratch),
-    (ki, ri, si): (&[f32], &[Vec<(usize, f32)>], &mut WideScratch),
-    maps: &mut Plane<Lanes>,
-    c: &Lanes,
-) -> bool {
-    let (w, h) = maps.size();
-    let Some((first_i, npair)) = si.fits(ki, ri, maps, maps) else { return false };
-    let Some((_, npair_e)) = se.fits(ke, re, maps, maps) else { return false };
-    let (hw_e, hw_i) = ((ke.len() - 1) / 2, (ki.len() - 1) / 2);
-    if w < 2 || si.odd.len() + 1 != si.even.len() || hw_e > hw_i || npair_e != npair {
-        return false;
-    }
-    // The excitatory taps read the inhibitory buffers: pixel x sits at x + si.off there, and
-    // its reach (hw_e <= hw_i) stays inside what `si.fits` checked.
-    let first_e = si.off - hw_e;
-    let wp = 2 * npair;
-    for y in 0..h {
-        // SAFETY: AVX-512 F was promised by the caller; `odd` is one pair shorter (checked).
-        unsafe { si.load_pairs_avx512(maps.row(y)) };
-        let (oi, oe) = (&mut si.tmp[y * npair..(y + 1) * npair], &mut se.tmp[y * npair..(y + 1) * npair]);
-        for (x0, p) in blocks_up_to(wp, 10) {
-            // SAFETY: as in `preserving_lanes_avx512`, for both kernels.
-            unsafe {
-                match p {
-                    10 => {
-                        row_block::<10>(&si.even, &si.odd, first_i, ki, &si.fx_pairs, oi, x0);
-                        row_block::<10>(&si.even, &si.odd, first_e, ke, &se.fx_pairs, oe, x0);
-                    }
-                    8 => {
-                        row_block::<8>(&si.even, &si.odd, first_i, ki, &si.fx_pairs, oi, x0);
-                        row_block::<8>(&si.even, &si.odd, first_e, ke, &se.fx_pairs, oe, x0);
-                    }
-                    4 => {
-                        row_block::<4>(&si.even, &si.odd, first_i, ki, &si.fx_pairs, oi, x0);
-                        row_block::<4>(&si.even, &si.odd, first_e, ke, &se.fx_pairs, oe, x0);
-                    }
-                    _ => {
-                        row_block::<1>(&si.even, &si.odd, first_i, ki, &si.fx_pairs, oi, x0);
-                        row_block::<1>(&si.even, &si.odd, first_e, ke, &se.fx_pairs, oe, x0);
-                    }
-                }
-            }
-        }
-    }
-    let (te, ti) = (se.tmp.as_ptr() as *const f32, si.tmp.as_ptr() as *const f32);
-    let stride = npair * 16;
-    // SAFETY: the features were promised by the caller.
-    let (cv, z) = unsafe { (twice(c), _mm512_setzero_ps()) };
-    let mut y = 0;
-    while y < h {
-        let two = y + 1 < h;
-        let rows =
-            [maps.row_mut(y).as_mut_ptr() as *mut f32, maps.row_mut((y + 1).min(h - 1)).as_mut_ptr() as *mut f32];
-        let (tap_e, tap_i) = ([&re[y][..], &re[(y + 1).min(h - 1)][..]], [&ri[y][..], &ri[(y + 1).min(h - 1)][..]]);
-        // Pixels below `from` are done: the last block may start inside the one before it,
-        // and a competition must not run twice on a pixel.
-        let mut from = 0;
-        for (x0, p) in blocks(w) {
-            let args = Epilogue { rows, n_rows: if two { 2 } else { 1 }, x0, from, c: cv, z };
-            // SAFETY: every tap's row is below h (checked above) and x0 + 2 P <= w.
-            unsafe {
-                match p {
-                    8 => dog_block::<8>(te, ti, stride, tap_e, tap_i, &args),
-                    4 => dog_block::<4>(te, ti, stride, tap_e, tap_i, &args),
-                    _ => dog_block::<1>(te, ti, stride, tap_e, tap_i, &args),
-                }
-            }
-            from = x0 + 2 * p;
-        }
-        y += 2;
-    }
-    true
-}
-
-/// Where [`dog_block`] writes: the map rows (one or two), the block's first pixel, the
-/// first pixel not yet done, and the constant and zero vectors.
-struct Epilogue {
-    rows: [*mut f32; 2],
-    n_rows: usize,
-    x0: usize,
-    from: usize,
-    c: __m512,
-    z: __m512,
-}
-
-/// `2 P` pixels from `x0` of one or two map rows: both vertical sums ([`col_sums2`] or
-/// [`col_sums`], as the separate filter takes them), then the competition in place on the
-/// pixels from `from` on.
-#[inline(always)]
-unsafe fn dog_block<const P: usize>(
-    te: *const f32,
-    ti: *const f32,
-    stride: usize,
-    tap_e: [&[(usize, f32)]; 2],
-    tap_i: [&[(usize, f32)]; 2],
-    g: &Epilogue,
-) {
-    // SAFETY: the caller keeps [x0, x0 + 2 P) within the rows and every tap row below h.
-    unsafe {
-        let (e, i) = if g.n_rows == 2 {
-            (col_sums2::<P>(te, stride, tap_e, g.x0), col_sums2::<P>(ti, stride, tap_i, g.x0))
-        } else {
-            let (e, i) = (col_sums::<P>(te, stride, tap_e[0], g.x0), col_sums::<P>(ti, stride, tap_i[0], g.x0));
-            ([e, e], [i, i])
-        };
-        for r in 0..g.n_rows {
-            for k in 0..P {
-                let px = g.x0 + 2 * k;
-                let mask = (if px >= g.from { 0x00FFu16 } else { 0 }) | (if px + 1 >= g.from { 0xFF00 } else { 0 });
-                let q = g.rows[r].add(px * 8);
-                let m = _mm512_maskz_loadu_ps(mask, q);
-                _mm512_mask_storeu_ps(q, mask, compete_vector(m, e[r][k], i[r][k], g.c, g.z));
-            }
-        }
-    }
-}
-
 /// The blocks `(x0, pairs)` covering [0, w) (w >= 2): 8 pairs of pixels while they fit, then
 /// 4, then single pairs, the last aligned to the end (a pixel may be computed twice, with the
 /// same result). A plain iterator, not a callback: a closure would not be compiled with the
 /// kernel's target features.
 #[inline(always)]
-fn blocks(w: usize) -> impl Iterator<Item = (usize, usize)> {
+pub(in crate::preserving) fn blocks(w: usize) -> impl Iterator<Item = (usize, usize)> {
     blocks_up_to(w, 8)
 }
 
@@ -396,7 +218,7 @@ fn blocks(w: usize) -> impl Iterator<Item = (usize, usize)> {
 /// 10 + 10 pairs runs at full rate where 8 + 8 + 4 ran its last block at half. (The vertical
 /// pass computes two rows per block, so its 4-pair blocks have 8 chains already.)
 #[inline(always)]
-fn blocks_up_to(w: usize, widest: usize) -> impl Iterator<Item = (usize, usize)> {
+pub(in crate::preserving) fn blocks_up_to(w: usize, widest: usize) -> impl Iterator<Item = (usize, usize)> {
     let mut x = 0;
     std::iter::from_fn(move || {
         if x >= w {
@@ -421,7 +243,7 @@ fn blocks_up_to(w: usize, widest: usize) -> impl Iterator<Item = (usize, usize)>
 /// with `p[i]` padded pixel `i + first` (`first = off - hw`), read as aligned pairs from
 /// `even` or `odd` by the parity of the pixel.
 #[inline(always)]
-unsafe fn row_block<const P: usize>(
+pub(in crate::preserving) unsafe fn row_block<const P: usize>(
     even: &[Pair],
     odd: &[Pair],
     first: usize,
@@ -463,7 +285,12 @@ unsafe fn col_block<const P: usize>(tmp: *const f32, stride: usize, taps: &[(usi
 
 /// The sums of [`col_block`], in registers.
 #[inline(always)]
-unsafe fn col_sums<const P: usize>(tmp: *const f32, stride: usize, taps: &[(usize, f32)], x0: usize) -> [__m512; P] {
+pub(in crate::preserving) unsafe fn col_sums<const P: usize>(
+    tmp: *const f32,
+    stride: usize,
+    taps: &[(usize, f32)],
+    x0: usize,
+) -> [__m512; P] {
     // SAFETY: the caller keeps [x0, x0 + 2 P) within the rows and every r_i < height.
     unsafe {
         let mut a = [_mm512_setzero_ps(); P];
@@ -503,7 +330,7 @@ unsafe fn col_block2<const P: usize>(
 
 /// The sums of [`col_block2`], in registers.
 #[inline(always)]
-unsafe fn col_sums2<const P: usize>(
+pub(in crate::preserving) unsafe fn col_sums2<const P: usize>(
     tmp: *const f32,
     stride: usize,
     taps: [&[(usize, f32)]; 2],
@@ -608,7 +435,7 @@ pub(super) unsafe fn preserving_lanes_avx2(
 /// `fx[x] sum_t k[t] p[x + t]`, padded pixel `i` at `e + 8 (i + first)`; the factor of
 /// pixel x is float `8 x` of the factor pairs (see [`WideScratch::new`]).
 #[inline(always)]
-unsafe fn pixel_row_block<const P: usize>(
+pub(in crate::preserving) unsafe fn pixel_row_block<const P: usize>(
     e: *const f32,
     first: usize,
     k: &[f32],
@@ -645,6 +472,23 @@ unsafe fn pixel_col_block<const P: usize>(
 ) {
     // SAFETY: the caller keeps [x0, x0 + P) within the rows and every r_i < height.
     unsafe {
+        let a = pixel_col_sums::<P>(tmp, stride, taps, x0);
+        for (j, a) in a.iter().enumerate() {
+            _mm256_storeu_ps(out.add((x0 + j) * 8), *a);
+        }
+    }
+}
+
+/// The vertical sums of `P` pixels from `x0` (as the AVX2 filter's column pass takes them).
+#[inline(always)]
+pub(in crate::preserving) unsafe fn pixel_col_sums<const P: usize>(
+    tmp: *const f32,
+    stride: usize,
+    taps: &[(usize, f32)],
+    x0: usize,
+) -> [__m256; P] {
+    // SAFETY: the caller keeps [x0, x0 + P) within the rows and every r_i < height.
+    unsafe {
         let mut a = [_mm256_setzero_ps(); P];
         for &(r, wt) in taps {
             let s = tmp.add(r * stride + x0 * 8);
@@ -653,8 +497,6 @@ unsafe fn pixel_col_block<const P: usize>(
                 *a = _mm256_fmadd_ps(wv, _mm256_load_ps(s.add(8 * j)), *a);
             }
         }
-        for (j, a) in a.iter().enumerate() {
-            _mm256_storeu_ps(out.add((x0 + j) * 8), *a);
-        }
+        a
     }
 }
