@@ -5,10 +5,10 @@ use crate::{Backend, ImageError, Plane, Result};
 
 /// Correlates every row of `src` with each kernel of `kernels` (centred) into the plane of
 /// `dsts` at the same index (each resized to `src`): the same values as [`filter_rows`] per
-/// kernel, bit for bit. With AVX-512 and 2 to 8 symmetric kernels (even or odd) of one
-/// length up to 33 taps, the row is padded once and the shifted vectors are formed once for
-/// all of them (the Gabor bank's six row passes take about the time of two); otherwise it
-/// is [`filter_rows`] per kernel.
+/// kernel, bit for bit. With AVX-512 or AVX2 and 2 to 8 symmetric kernels (even or odd) of
+/// one length up to 33 taps, the row is padded once and the shifted vectors are formed once
+/// for all of them (the Gabor bank's six row passes take about the time of two with
+/// AVX-512); otherwise it is [`filter_rows`] per kernel.
 pub fn filter_rows_bank(
     backend: Backend,
     src: &Plane<f32>,
@@ -28,7 +28,7 @@ pub fn filter_rows_bank(
         check_kernel(k, "horizontal")?;
     }
     #[cfg(target_arch = "x86_64")]
-    if backend.resolve() == Backend::Avx512 && (2..=super::x86::BANK_MAX).contains(&kernels.len()) {
+    if backend.has_avx2() && (2..=super::x86::BANK_MAX).contains(&kernels.len()) {
         // Indices of the even and the odd kernels, on the stack: this runs per level and frame.
         let (mut even, mut odd) = ([0usize; super::x86::BANK_MAX], [0usize; super::x86::BANK_MAX]);
         let (mut ne, mut no) = (0, 0);
@@ -50,8 +50,10 @@ pub fn filter_rows_bank(
                 d.resize(src.width(), src.height());
             }
             let p = &mut scratch.padded;
-            // SAFETY: `resolve()` returns Avx512 only on CPUs with AVX-512 F/BW/VL/DQ, AVX2 and FMA.
-            if unsafe { bank_dispatch(src, kernels, (&even[..ne], &odd[..no]), dsts, border, p) } {
+            let wide = backend.resolve() == Backend::Avx512;
+            // SAFETY: `has_avx2()` holds only on CPUs with AVX2 and FMA, and `resolve()`
+            // returns Avx512 only on CPUs with AVX-512 F/BW/VL/DQ besides.
+            if unsafe { bank_dispatch(wide, src, kernels, (&even[..ne], &odd[..no]), dsts, border, p) } {
                 return Ok(());
             }
         }
@@ -62,13 +64,14 @@ pub fn filter_rows_bank(
     Ok(())
 }
 
-/// [`super::x86::bank_rows_avx512`] for the even kernels at `even` and the odd ones at
-/// `odd` (false for counts it was not instantiated for).
+/// [`super::x86::bank_rows_avx512`] (`wide`) or [`super::x86::bank_rows_avx2`] for the even
+/// kernels at `even` and the odd ones at `odd` (false for counts it was not instantiated for).
 ///
 /// # Safety
-/// The CPU must have AVX-512 F, AVX2 and FMA.
+/// The CPU must have AVX2 and FMA, and AVX-512 F for `wide`.
 #[cfg(target_arch = "x86_64")]
 unsafe fn bank_dispatch(
+    wide: bool,
     src: &Plane<f32>,
     ks: &[&[f32]],
     (even, odd): (&[usize], &[usize]),
@@ -76,12 +79,14 @@ unsafe fn bank_dispatch(
     border: Border,
     p: &mut Vec<f32>,
 ) -> bool {
-    use super::x86::bank_rows_avx512 as f;
+    use super::x86::{bank_rows_avx2, bank_rows_avx512};
     macro_rules! arms {
         ($(($e:literal, $o:literal)),*) => {
             match (even.len(), odd.len()) {
                 // SAFETY: the caller's promise.
-                $(($e, $o) => unsafe { f::<$e, $o>(src, ks, (even, odd), ds, border, p) },)*
+                $(($e, $o) if wide => unsafe { bank_rows_avx512::<$e, $o>(src, ks, (even, odd), ds, border, p) },)*
+                // SAFETY: the caller's promise.
+                $(($e, $o) => unsafe { bank_rows_avx2::<$e, $o>(src, ks, (even, odd), ds, border, p) },)*
                 _ => false,
             }
         };

@@ -534,3 +534,103 @@ unsafe fn bank_vector<const E: usize, const O: usize>(
         }
     }
 }
+
+/// [`bank_rows_avx512`] with 256-bit registers and unaligned loads, as
+/// [`correlate_folded_avx2`] computes each kernel alone (bit for bit): the two shifted
+/// vectors of each tap, and their sum and difference, are loaded and formed once for every
+/// kernel of the bank. False (nothing written) when the sizes or kernels do not fit.
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA.
+#[target_feature(enable = "avx2,fma")]
+pub(super) unsafe fn bank_rows_avx2<const E: usize, const O: usize>(
+    src: &Plane<f32>,
+    ks: &[&[f32]],
+    (even, odd): (&[usize], &[usize]),
+    dsts: &mut [Plane<f32>],
+    border: super::Border,
+    padded: &mut Vec<f32>,
+) -> bool {
+    let (w, h_img) = src.size();
+    let Some(len) = ks.first().map(|k| k.len()) else { return false };
+    let h = len / 2;
+    let n = ks.len();
+    if even.len() != E
+        || odd.len() != O
+        || dsts.len() != n
+        || even.iter().chain(odd).any(|&i| i >= n)
+        || (0..n).any(|i| even.iter().chain(odd).filter(|&&j| j == i).count() != 1)
+        || w < 8
+        || len.is_multiple_of(2)
+        || h > FOLDED_512_MAX_HALF
+        || ks.iter().any(|k| k.len() != len)
+        || dsts.iter().any(|d| d.size() != (w, h_img))
+    {
+        return false;
+    }
+    let tap_table = |k: &[f32]| {
+        let mut t = [0f32; FOLDED_512_MAX_HALF + 1];
+        t[..=h].copy_from_slice(&k[h..]);
+        t
+    };
+    let we: [[f32; FOLDED_512_MAX_HALF + 1]; E] = std::array::from_fn(|i| tap_table(ks[even[i]]));
+    let wo: [[f32; FOLDED_512_MAX_HALF + 1]; O] = std::array::from_fn(|i| tap_table(ks[odd[i]]));
+    padded.resize(w + 2 * h, 0.0);
+    for y in 0..h_img {
+        super::pad_into(src.row(y), h, border, &mut padded[..w + 2 * h]);
+        let c = padded.as_ptr().wrapping_add(h);
+        // Distinct planes (each index once, checked above), so the rows do not alias.
+        let oe: [*mut f32; E] = std::array::from_fn(|i| dsts[even[i]].row_mut(y).as_mut_ptr());
+        let oo: [*mut f32; O] = std::array::from_fn(|i| dsts[odd[i]].row_mut(y).as_mut_ptr());
+        let mut x = 0;
+        while x < w {
+            // Eight outputs at a time, the last eight aligned to the end (a few recomputed,
+            // with the same values).
+            let x0 = if x + 8 <= w { x } else { w - 8 };
+            // SAFETY: the loads read padded[x0 .. x0 + 8 + 2 h], inside the padded row.
+            unsafe { bank_pixels8::<E, O>(c, (&oe, &oo), x0, (&we, &wo), h) };
+            x = x0 + 8;
+        }
+    }
+    true
+}
+
+/// Eight outputs from `x0` of every kernel of [`bank_rows_avx2`], each as
+/// [`correlate_folded_avx2`] computes it.
+#[allow(clippy::type_complexity)]
+#[inline(always)]
+unsafe fn bank_pixels8<const E: usize, const O: usize>(
+    c: *const f32,
+    (oe, oo): (&[*mut f32; E], &[*mut f32; O]),
+    x0: usize,
+    (we, wo): (&[[f32; FOLDED_512_MAX_HALF + 1]; E], &[[f32; FOLDED_512_MAX_HALF + 1]; O]),
+    h: usize,
+) {
+    // SAFETY: the caller keeps every load inside the padded row and the stores in the rows.
+    unsafe {
+        let a = _mm256_loadu_ps(c.add(x0));
+        let mut ae: [__m256; E] = std::array::from_fn(|k| _mm256_mul_ps(_mm256_set1_ps(we[k][0]), a));
+        let mut ao = [_mm256_setzero_ps(); O];
+        for t in 1..=h {
+            let (sp, sm) = (_mm256_loadu_ps(c.add(x0 + t)), _mm256_loadu_ps(c.add(x0).sub(t)));
+            if E > 0 {
+                let s = _mm256_add_ps(sp, sm);
+                for k in 0..E {
+                    ae[k] = _mm256_fmadd_ps(_mm256_set1_ps(we[k][t]), s, ae[k]);
+                }
+            }
+            if O > 0 {
+                let d = _mm256_sub_ps(sp, sm);
+                for k in 0..O {
+                    ao[k] = _mm256_fmadd_ps(_mm256_set1_ps(wo[k][t]), d, ao[k]);
+                }
+            }
+        }
+        for k in 0..E {
+            _mm256_storeu_ps(oe[k].add(x0), ae[k]);
+        }
+        for k in 0..O {
+            _mm256_storeu_ps(oo[k].add(x0), ao[k]);
+        }
+    }
+}
