@@ -28,6 +28,18 @@ pub(super) unsafe fn columns_avx512(cols: &Columns, row: &[f32], out: &mut [f32]
             _mm512_storeu_ps(out.as_mut_ptr().add(o), _mm512_fmadd_ps(w, _mm512_sub_ps(b, a), a));
             o += 16;
         }
+        if o < n && n >= 16 {
+            // The rest as one vector aligned to the end (recomputing a few outputs, with the
+            // same values): 40-wide maps left 8 scalar outputs a row.
+            let o0 = n - 16;
+            let i0 = _mm512_loadu_si512(cols.i0.as_ptr().add(o0) as *const _);
+            let i1 = _mm512_loadu_si512(cols.i1.as_ptr().add(o0) as *const _);
+            let w = _mm512_loadu_ps(cols.w.as_ptr().add(o0));
+            let a = _mm512_i32gather_ps::<4>(i0, row.as_ptr());
+            let b = _mm512_i32gather_ps::<4>(i1, row.as_ptr());
+            _mm512_storeu_ps(out.as_mut_ptr().add(o0), _mm512_fmadd_ps(w, _mm512_sub_ps(b, a), a));
+            o = n;
+        }
     }
     for o in o..n {
         let (a, b) = (row[cols.i0[o] as usize], row[cols.i1[o] as usize]);
