@@ -446,7 +446,23 @@ fn pyr_down_rgb8_generic<M: Madd>(
             if !done {
                 vertical_bytes_u16(src, &s.itaps, &mut s.row16);
             }
-            split_even_odd(&s.row16, 1.0 / (d as f32 * 255.0), [e0, e1, e2], [o0, o1, o2]);
+            let scale = 1.0 / (d as f32 * 255.0);
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above.
+            let split = M::AVX512
+                && unsafe {
+                    x86::split_even_odd_avx512(
+                        &s.row16,
+                        scale,
+                        [&mut *e0, &mut *e1, &mut *e2],
+                        [&mut *o0, &mut *o1, &mut *o2],
+                    )
+                };
+            #[cfg(not(target_arch = "x86_64"))]
+            let split = false;
+            if !split {
+                split_even_odd(&s.row16, scale, [e0, e1, e2], [o0, o1, o2]);
+            }
         } else {
             vertical_bytes::<M>(src, j, h, kernel, &mut s.taps, &mut s.row3);
             // Scaling by 1 is exact: the same values as a plain split.
