@@ -11,16 +11,6 @@ use ocellus_image::preserving::Lanes;
 use ocellus_image::Plane;
 use std::arch::x86_64::*;
 
-/// A lane vector repeated over two pixels.
-#[inline(always)]
-unsafe fn twice(v: &Lanes) -> __m512 {
-    // SAFETY: `v` holds 8 floats; the caller has AVX-512 F.
-    unsafe {
-        let h = _mm256_loadu_ps(v.as_ptr());
-        _mm512_insertf32x8::<1>(_mm512_castps256_ps512(h), h)
-    }
-}
-
 /// Per-lane (min, max), as `lanes_min_max_generic`.
 ///
 /// # Safety
@@ -63,7 +53,13 @@ pub(super) unsafe fn lanes_min_max(maps: &Plane<Lanes>) -> (Lanes, Lanes) {
 #[target_feature(enable = "avx512f,avx512dq,avx2,fma")]
 pub(super) unsafe fn lanes_affine(maps: &mut Plane<Lanes>, scale: &Lanes, offset: &Lanes) {
     // SAFETY: the features were promised by the caller.
-    let (s, o, z) = unsafe { (twice(scale), twice(offset), _mm512_setzero_ps()) };
+    let (s, o, z) = unsafe {
+        (
+            _mm512_broadcast_f32x8(_mm256_loadu_ps(scale.as_ptr())),
+            _mm512_broadcast_f32x8(_mm256_loadu_ps(offset.as_ptr())),
+            _mm512_setzero_ps(),
+        )
+    };
     for y in 0..maps.height() {
         let (pairs, rest) = maps.row_mut(y).as_chunks_mut::<2>();
         for p in pairs {

@@ -246,6 +246,28 @@ pub(super) unsafe fn correlate_folded_avx2(p: &[f32], k: &[f32], odd: bool, out:
     true
 }
 
+/// `$m!(t)` for the tap offsets 1 to 15: `valignd` takes its shift as an immediate, so each
+/// offset is written out (the tap macros skip those beyond the kernel's half-width).
+macro_rules! each_tap_1_to_15 {
+    ($m:ident) => {
+        $m!(1);
+        $m!(2);
+        $m!(3);
+        $m!(4);
+        $m!(5);
+        $m!(6);
+        $m!(7);
+        $m!(8);
+        $m!(9);
+        $m!(10);
+        $m!(11);
+        $m!(12);
+        $m!(13);
+        $m!(14);
+        $m!(15);
+    };
+}
+
 /// Longest half-width `h` that [`correlate_folded_avx512`] takes (kernels of up to 33 taps):
 /// every tap then reads from the aligned vectors just before, at and after an output's.
 pub(super) const FOLDED_512_MAX_HALF: usize = 16;
@@ -351,21 +373,7 @@ unsafe fn folded_vectors<const L: usize>(
                 }
             };
         }
-        tap!(1);
-        tap!(2);
-        tap!(3);
-        tap!(4);
-        tap!(5);
-        tap!(6);
-        tap!(7);
-        tap!(8);
-        tap!(9);
-        tap!(10);
-        tap!(11);
-        tap!(12);
-        tap!(13);
-        tap!(14);
-        tap!(15);
+        each_tap_1_to_15!(tap);
         if h >= 16 {
             for j in 0..L {
                 let s = if odd { _mm512_sub_ps(b[j], m[j]) } else { _mm512_add_ps(b[j], m[j]) };
@@ -383,6 +391,48 @@ unsafe fn folded_vectors<const L: usize>(
 
 /// Most kernels [`bank_rows_avx512`] filters a row with at once.
 pub(super) const BANK_MAX: usize = 8;
+
+/// The taps of a bank's even and odd kernels (centre first), after the checks both bank
+/// kernels need: `E` even and `O` odd indices, each kernel once, all of one odd length of
+/// half-width `h` at most [`FOLDED_512_MAX_HALF`], the outputs `src`'s size, `src` at least
+/// 8 wide.
+struct BankTaps<const E: usize, const O: usize> {
+    h: usize,
+    we: [[f32; FOLDED_512_MAX_HALF + 1]; E],
+    wo: [[f32; FOLDED_512_MAX_HALF + 1]; O],
+}
+
+impl<const E: usize, const O: usize> BankTaps<E, O> {
+    fn new(src: &Plane<f32>, ks: &[&[f32]], (even, odd): (&[usize], &[usize]), dsts: &[Plane<f32>]) -> Option<Self> {
+        let (w, h_img) = src.size();
+        let len = ks.first()?.len();
+        let h = len / 2;
+        let n = ks.len();
+        let fits = even.len() == E
+            && odd.len() == O
+            && dsts.len() == n
+            && even.iter().chain(odd).all(|&i| i < n)
+            && (0..n).all(|i| even.iter().chain(odd).filter(|&&j| j == i).count() == 1)
+            && w >= 8
+            && !len.is_multiple_of(2)
+            && h <= FOLDED_512_MAX_HALF
+            && ks.iter().all(|k| k.len() == len)
+            && dsts.iter().all(|d| d.size() == (w, h_img));
+        if !fits {
+            return None;
+        }
+        let table = |k: &[f32]| {
+            let mut t = [0f32; FOLDED_512_MAX_HALF + 1];
+            t[..=h].copy_from_slice(&k[h..]);
+            t
+        };
+        Some(Self {
+            h,
+            we: std::array::from_fn(|i| table(ks[even[i]])),
+            wo: std::array::from_fn(|i| table(ks[odd[i]])),
+        })
+    }
+}
 
 /// Every row of `src` through each of the kernels `ks` (all of one odd length, half-width at
 /// most [`FOLDED_512_MAX_HALF`]; those at the indices `even` even-symmetric, those at `odd`
@@ -407,30 +457,7 @@ pub(super) unsafe fn bank_rows_avx512<const E: usize, const O: usize>(
     padded: &mut Vec<f32>,
 ) -> bool {
     let (w, h_img) = src.size();
-    let Some(len) = ks.first().map(|k| k.len()) else { return false };
-    let h = len / 2;
-    let n = ks.len();
-    if even.len() != E
-        || odd.len() != O
-        || dsts.len() != n
-        || even.iter().chain(odd).any(|&i| i >= n)
-        || (0..n).any(|i| even.iter().chain(odd).filter(|&&j| j == i).count() != 1)
-        || w < 8
-        || len.is_multiple_of(2)
-        || h > FOLDED_512_MAX_HALF
-        || ks.iter().any(|k| k.len() != len)
-        || dsts.iter().any(|d| d.size() != (w, h_img))
-    {
-        return false;
-    }
-    // Taps per kernel, the centre first.
-    let tap_table = |k: &[f32]| {
-        let mut t = [0f32; FOLDED_512_MAX_HALF + 1];
-        t[..=h].copy_from_slice(&k[h..]);
-        t
-    };
-    let we: [[f32; FOLDED_512_MAX_HALF + 1]; E] = std::array::from_fn(|i| tap_table(ks[even[i]]));
-    let wo: [[f32; FOLDED_512_MAX_HALF + 1]; O] = std::array::from_fn(|i| tap_table(ks[odd[i]]));
+    let Some(BankTaps { h, we, wo }) = BankTaps::<E, O>::new(src, ks, (even, odd), dsts) else { return false };
     // The padded row placed as `rows_pass` places it: output 0's centre on a cache line.
     padded.resize(w + 2 * h + 96, 0.0);
     let first = padded.as_ptr() as usize / 4 + h;
@@ -500,21 +527,7 @@ unsafe fn bank_vector<const E: usize, const O: usize>(
                 }
             };
         }
-        tap!(1);
-        tap!(2);
-        tap!(3);
-        tap!(4);
-        tap!(5);
-        tap!(6);
-        tap!(7);
-        tap!(8);
-        tap!(9);
-        tap!(10);
-        tap!(11);
-        tap!(12);
-        tap!(13);
-        tap!(14);
-        tap!(15);
+        each_tap_1_to_15!(tap);
         if h >= 16 {
             let (s, d) = (_mm512_add_ps(b, m), _mm512_sub_ps(b, m));
             for k in 0..E {
@@ -552,29 +565,7 @@ pub(super) unsafe fn bank_rows_avx2<const E: usize, const O: usize>(
     padded: &mut Vec<f32>,
 ) -> bool {
     let (w, h_img) = src.size();
-    let Some(len) = ks.first().map(|k| k.len()) else { return false };
-    let h = len / 2;
-    let n = ks.len();
-    if even.len() != E
-        || odd.len() != O
-        || dsts.len() != n
-        || even.iter().chain(odd).any(|&i| i >= n)
-        || (0..n).any(|i| even.iter().chain(odd).filter(|&&j| j == i).count() != 1)
-        || w < 8
-        || len.is_multiple_of(2)
-        || h > FOLDED_512_MAX_HALF
-        || ks.iter().any(|k| k.len() != len)
-        || dsts.iter().any(|d| d.size() != (w, h_img))
-    {
-        return false;
-    }
-    let tap_table = |k: &[f32]| {
-        let mut t = [0f32; FOLDED_512_MAX_HALF + 1];
-        t[..=h].copy_from_slice(&k[h..]);
-        t
-    };
-    let we: [[f32; FOLDED_512_MAX_HALF + 1]; E] = std::array::from_fn(|i| tap_table(ks[even[i]]));
-    let wo: [[f32; FOLDED_512_MAX_HALF + 1]; O] = std::array::from_fn(|i| tap_table(ks[odd[i]]));
+    let Some(BankTaps { h, we, wo }) = BankTaps::<E, O>::new(src, ks, (even, odd), dsts) else { return false };
     padded.resize(w + 2 * h, 0.0);
     for y in 0..h_img {
         super::pad_into(src.row(y), h, border, &mut padded[..w + 2 * h]);

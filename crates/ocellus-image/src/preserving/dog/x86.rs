@@ -6,16 +6,6 @@ use super::super::{Lanes, WideScratch};
 use crate::Plane;
 use std::arch::x86_64::*;
 
-/// A lane vector repeated over two pixels.
-#[inline(always)]
-unsafe fn twice(v: &Lanes) -> __m512 {
-    // SAFETY: `v` holds 8 floats; the caller has AVX-512 F.
-    unsafe {
-        let h = _mm256_loadu_ps(v.as_ptr());
-        _mm512_insertf32x8::<1>(_mm512_castps256_ps512(h), h)
-    }
-}
-
 /// `M <- max(0, M + E - I - c)` per lane, as `compete_lanes_generic` (two pixels per
 /// 512-bit register: on `[f32; 8]` pixels LLVM vectorized the loop across pixels, one lane at
 /// a time with gathers and scatters).
@@ -30,7 +20,7 @@ pub(in crate::preserving) unsafe fn compete_lanes(
     c: &Lanes,
 ) {
     // SAFETY: the features were promised by the caller.
-    let (cv, z) = unsafe { (twice(c), _mm512_setzero_ps()) };
+    let (cv, z) = unsafe { (_mm512_broadcast_f32x8(_mm256_loadu_ps(c.as_ptr())), _mm512_setzero_ps()) };
     for y in 0..maps.height() {
         let (e, i) = (excit.row(y).as_chunks::<2>(), inhib.row(y).as_chunks::<2>());
         let (pairs, rest) = maps.row_mut(y).as_chunks_mut::<2>();
@@ -57,6 +47,23 @@ unsafe fn compete_vector(m: __m512, e: __m512, i: __m512, c: __m512, z: __m512) 
     unsafe { _mm512_max_ps(_mm512_sub_ps(_mm512_sub_ps(_mm512_add_ps(m, e), i), c), z) }
 }
 
+/// The checks both fused steps need, and where their horizontal passes start: `Some((first_i,
+/// first_e, npair))` when both filters' buffers fit `maps` and the excitatory kernel is not
+/// the longer (it then reads the inhibitory filter's padded row, pixel x at x + `si.off`,
+/// and reaches no further than what `si.fits` checked); `npair` pairs per row of `tmp`.
+#[allow(clippy::type_complexity)]
+fn fused_fits(
+    (ke, re, se): (&[f32], &[Vec<(usize, f32)>], &WideScratch),
+    (ki, ri, si): (&[f32], &[Vec<(usize, f32)>], &WideScratch),
+    maps: &Plane<Lanes>,
+) -> Option<(usize, usize, usize)> {
+    let (first_i, npair) = si.fits(ki, ri, maps, maps)?;
+    let (_, npair_e) = se.fits(ke, re, maps, maps)?;
+    let hw_e = ke.len().checked_sub(1)? / 2;
+    let first_e = si.off.checked_sub(hw_e)?;
+    (hw_e <= ki.len().saturating_sub(1) / 2 && npair_e == npair).then_some((first_i, first_e, npair))
+}
+
 /// One step of the iterative difference of Gaussians on eight interleaved maps, fused:
 /// `maps <- max(0, maps + E - I - c)` with `E` and `I` the excitatory and inhibitory
 /// energy-preserving filters of `maps` (kernels `ke`, `ki`, vertical taps `re`, `ri`, buffers
@@ -78,15 +85,10 @@ pub(in crate::preserving) unsafe fn dog_step_avx512(
     c: &Lanes,
 ) -> bool {
     let (w, h) = maps.size();
-    let Some((first_i, npair)) = si.fits(ki, ri, maps, maps) else { return false };
-    let Some((_, npair_e)) = se.fits(ke, re, maps, maps) else { return false };
-    let (hw_e, hw_i) = ((ke.len() - 1) / 2, (ki.len() - 1) / 2);
-    if w < 2 || si.odd.len() + 1 != si.even.len() || hw_e > hw_i || npair_e != npair {
+    let Some((first_i, first_e, npair)) = fused_fits((ke, re, se), (ki, ri, si), maps) else { return false };
+    if w < 2 || si.odd.len() + 1 != si.even.len() {
         return false;
     }
-    // The excitatory taps read the inhibitory buffers: pixel x sits at x + si.off there, and
-    // its reach (hw_e <= hw_i) stays inside what `si.fits` checked.
-    let first_e = si.off - hw_e;
     let wp = 2 * npair;
     for y in 0..h {
         // SAFETY: AVX-512 F was promised by the caller; `odd` is one pair shorter (checked).
@@ -119,7 +121,7 @@ pub(in crate::preserving) unsafe fn dog_step_avx512(
     let (te, ti) = (se.tmp.as_ptr() as *const f32, si.tmp.as_ptr() as *const f32);
     let stride = npair * 16;
     // SAFETY: the features were promised by the caller.
-    let (cv, z) = unsafe { (twice(c), _mm512_setzero_ps()) };
+    let (cv, z) = unsafe { (_mm512_broadcast_f32x8(_mm256_loadu_ps(c.as_ptr())), _mm512_setzero_ps()) };
     let mut y = 0;
     while y < h {
         let two = y + 1 < h;
@@ -206,14 +208,7 @@ pub(in crate::preserving) unsafe fn dog_step_avx2(
     c: &Lanes,
 ) -> bool {
     let (w, h) = maps.size();
-    let Some((first_i, npair)) = si.fits(ki, ri, maps, maps) else { return false };
-    let Some((_, npair_e)) = se.fits(ke, re, maps, maps) else { return false };
-    let (hw_e, hw_i) = ((ke.len() - 1) / 2, (ki.len() - 1) / 2);
-    if hw_e > hw_i || npair_e != npair {
-        return false;
-    }
-    // As in `dog_step_avx512`: the excitatory taps read the inhibitory padded row.
-    let first_e = si.off - hw_e;
+    let Some((first_i, first_e, npair)) = fused_fits((ke, re, se), (ki, ri, si), maps) else { return false };
     let (step, wide) = if w >= 8 { (8, true) } else { (1, false) };
     for y in 0..h {
         si.load_row(maps.row(y));
