@@ -281,6 +281,15 @@ fn pad_into<T: Copy + Into<f32>>(row: &[T], hw: usize, border: Border, p: &mut [
     p[hw + w..].fill(last);
 }
 
+/// Sizes `padded` for a row of `w` values padded by `hw` on each side and returns where the
+/// padded row starts in it: output 0's centre (`start + hw`) on a cache-line boundary, with
+/// room for the aligned vectors the AVX-512 folded kernels read on both sides.
+fn aligned_padding(padded: &mut Vec<f32>, w: usize, hw: usize) -> usize {
+    padded.resize(w + 2 * hw + 96, 0.0);
+    let first = padded.as_ptr() as usize / 4 + hw;
+    16 + (16 - first % 16) % 16
+}
+
 /// Row list for output row `y` of a vertical pass with kernel `k` (centred).
 pub(crate) fn vertical_taps(y: usize, h: usize, k: &[f32], border: Border, rows: &mut Vec<(usize, f32)>) {
     let hw = (k.len() - 1) / 2;
@@ -312,12 +321,8 @@ fn rows_pass<M: Madd, T: Copy + Default + Into<f32>>(
     let sym = symmetry(kx);
     #[cfg(target_arch = "x86_64")]
     if M::AVX512 && sym != Symmetry::None && hwx <= x86::FOLDED_512_MAX_HALF {
-        // The padded row placed so that output 0's centre sits on a cache-line boundary,
-        // with room for the aligned vectors read on both sides (see the kernel).
         let w = x1 - x0;
-        padded.resize(w + 2 * hwx + 96, 0.0);
-        let first = padded.as_ptr() as usize / 4 + hwx;
-        let start = 16 + (16 - first % 16) % 16;
+        let start = aligned_padding(padded, w, hwx);
         for y in y0..y1 {
             pad_into(&src.row(y)[x0..x1], hwx, border, &mut padded[start..start + w + 2 * hwx]);
             // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512, which

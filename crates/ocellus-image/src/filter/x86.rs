@@ -459,9 +459,7 @@ pub(super) unsafe fn bank_rows_avx512<const E: usize, const O: usize>(
     let (w, h_img) = src.size();
     let Some(BankTaps { h, we, wo }) = BankTaps::<E, O>::new(src, ks, (even, odd), dsts) else { return false };
     // The padded row placed as `rows_pass` places it: output 0's centre on a cache line.
-    padded.resize(w + 2 * h + 96, 0.0);
-    let first = padded.as_ptr() as usize / 4 + h;
-    let start = 16 + (16 - first % 16) % 16;
+    let start = super::aligned_padding(padded, w, h);
     let nv = w.div_ceil(16);
     if padded.len() < start + h + nv * 16 + 32 {
         return false;

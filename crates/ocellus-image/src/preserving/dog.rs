@@ -2,11 +2,11 @@
 //! interleaved maps: the competition of N(.) (SPEC 1.6), `M <- max(0, M + E - I - c)`.
 
 use super::{Lanes, PreservingFilter};
+use crate::simd::Madd;
+use crate::{dispatch_kernel, Backend, Plane, Result};
 
 #[cfg(target_arch = "x86_64")]
 mod x86;
-use crate::simd::Madd;
-use crate::{dispatch_kernel, Backend, Plane, Result};
 
 /// `maps <- max(0, maps + E - I - c)` per lane, with `E` and `I` the maps through
 /// `excitation` and `inhibition` (both built for the maps' size; `excit` and `inhib` are
@@ -24,20 +24,16 @@ pub fn dog_step_lanes(
     crate::check::same_size("maps", maps.size(), (excitation.width, excitation.height))?;
     crate::check::same_size("maps", maps.size(), (inhibition.width, inhibition.height))?;
     #[cfg(target_arch = "x86_64")]
-    if backend.resolve() == Backend::Avx512 {
+    {
         let (e, i) = (&mut *excitation, &mut *inhibition);
-        // SAFETY: `resolve()` returns Avx512 only on CPUs with AVX-512 F/BW/VL/DQ, AVX2 and FMA.
-        let done =
-            unsafe { x86::dog_step_avx512((&e.k, &e.rows, &mut e.wide), (&i.k, &i.rows, &mut i.wide), maps, &c) };
-        if done {
-            return Ok(());
-        }
-    }
-    #[cfg(target_arch = "x86_64")]
-    if backend.resolve() == Backend::Avx2 {
-        let (e, i) = (&mut *excitation, &mut *inhibition);
-        // SAFETY: `resolve()` returns Avx2 only on CPUs with AVX2 and FMA.
-        let done = unsafe { x86::dog_step_avx2((&e.k, &e.rows, &mut e.wide), (&i.k, &i.rows, &mut i.wide), maps, &c) };
+        let (ex, inh) = ((&e.k[..], &e.rows[..], &mut e.wide), (&i.k[..], &i.rows[..], &mut i.wide));
+        // SAFETY: `resolve()` returns Avx512 only on CPUs with AVX-512 F/BW/VL/DQ, AVX2 and
+        // FMA, and Avx2 only on CPUs with AVX2 and FMA.
+        let done = match backend.resolve() {
+            Backend::Avx512 => unsafe { x86::dog_step_avx512(ex, inh, maps, &c) },
+            Backend::Avx2 => unsafe { x86::dog_step_avx2(ex, inh, maps, &c) },
+            _ => false,
+        };
         if done {
             return Ok(());
         }
@@ -65,12 +61,6 @@ fn excitation_then_inhibition(
 #[inline(always)]
 #[allow(clippy::extra_unused_type_parameters)] // dispatch_kernel! instantiates every kernel with a Madd
 fn compete_lanes_generic<M: Madd>(maps: &mut Plane<Lanes>, excit: &Plane<Lanes>, inhib: &Plane<Lanes>, c: Lanes) {
-    #[cfg(target_arch = "x86_64")]
-    if M::AVX512 {
-        // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512, which
-        // `dispatch_kernel!` calls only on CPUs that have it.
-        return unsafe { x86::compete_lanes(maps, excit, inhib, &c) };
-    }
     for y in 0..maps.height() {
         let (e, i) = (excit.row(y), inhib.row(y));
         for ((p, ev), iv) in maps.row_mut(y).iter_mut().zip(e).zip(i) {
@@ -91,7 +81,7 @@ mod tests {
         p.rows().flat_map(|r| r.as_flattened().iter().map(|v| v.to_bits())).collect()
     }
 
-    /// With every backend, the step (fused with AVX-512) gives that backend's filters and
+    /// With every backend, the step (fused with AVX-512 and AVX2) gives that backend's filters and
     /// competition run one after the other, bit for bit: widths odd and even (the last block
     /// then overlaps the one before), odd and even row counts, short and long kernels.
     #[test]
@@ -118,28 +108,6 @@ mod tests {
                     assert_eq!(bits(&want), bits(&got), "{te}/{ti} taps, {w}x{h}, {b:?}");
                 }
             }
-        }
-    }
-
-    /// The AVX-512 competition gives the generic one's results bit for bit.
-    #[cfg(target_arch = "x86_64")]
-    #[test]
-    fn avx512_competition_equals_the_generic_one_bit_for_bit() {
-        if !crate::simd::avx512_available() {
-            return;
-        }
-        let mut rng = crate::rng::SplitMix64::new(11);
-        for (w, h) in [(1, 1), (2, 3), (7, 5), (40, 30), (41, 31)] {
-            let mut map = || -> Plane<Lanes> {
-                Plane::from_fn(w, h, |_, _| std::array::from_fn(|_| rng.unit() as f32 * 4.0 - 1.0))
-            };
-            let (m, e, i) = (map(), map(), map());
-            let c: Lanes = std::array::from_fn(|l| 0.1 * l as f32);
-            let (mut a, mut b) = (m.clone(), m.clone());
-            compete_lanes_generic::<crate::simd::Fused>(&mut a, &e, &i, c);
-            // SAFETY: AVX-512 was checked above.
-            unsafe { super::x86::compete_lanes(&mut b, &e, &i, &c) };
-            assert_eq!(bits(&a), bits(&b), "{w}x{h}");
         }
     }
 }

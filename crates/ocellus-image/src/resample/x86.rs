@@ -17,31 +17,28 @@ use std::arch::x86_64::*;
 pub(super) unsafe fn columns_avx512(cols: &Columns, row: &[f32], out: &mut [f32]) {
     let n = out.len();
     let mut o = 0;
-    // SAFETY: every index is at most `max_index < row.len()`, and o + 16 <= n <= table lengths.
+    // SAFETY: every index is at most `max_index < row.len()`, and o0 + 16 <= n <= table lengths.
     unsafe {
-        while o + 16 <= n {
-            let i0 = _mm512_loadu_si512(cols.i0.as_ptr().add(o) as *const _);
-            let i1 = _mm512_loadu_si512(cols.i1.as_ptr().add(o) as *const _);
-            let w = _mm512_loadu_ps(cols.w.as_ptr().add(o));
-            let a = _mm512_i32gather_ps::<4>(i0, row.as_ptr());
-            let b = _mm512_i32gather_ps::<4>(i1, row.as_ptr());
-            _mm512_storeu_ps(out.as_mut_ptr().add(o), _mm512_fmadd_ps(w, _mm512_sub_ps(b, a), a));
-            o += 16;
-        }
-        if o < n && n >= 16 {
-            // The rest as one vector aligned to the end (recomputing a few outputs, with the
-            // same values): 40-wide maps left 8 scalar outputs a row.
-            let o0 = n - 16;
+        // 16 at a time, the last 16 aligned to the end (recomputing a few outputs, with the
+        // same values): a 40-wide row would otherwise end in 8 scalar outputs.
+        while o < n && n >= 16 {
+            let o0 = o.min(n - 16);
             let i0 = _mm512_loadu_si512(cols.i0.as_ptr().add(o0) as *const _);
             let i1 = _mm512_loadu_si512(cols.i1.as_ptr().add(o0) as *const _);
             let w = _mm512_loadu_ps(cols.w.as_ptr().add(o0));
             let a = _mm512_i32gather_ps::<4>(i0, row.as_ptr());
             let b = _mm512_i32gather_ps::<4>(i1, row.as_ptr());
             _mm512_storeu_ps(out.as_mut_ptr().add(o0), _mm512_fmadd_ps(w, _mm512_sub_ps(b, a), a));
-            o = n;
+            o = o0 + 16;
         }
     }
-    for o in o..n {
+    scalar_columns(cols, row, out, o);
+}
+
+/// Outputs `from..` of the column step, one at a time (rows shorter than a vector).
+#[inline(always)]
+fn scalar_columns(cols: &Columns, row: &[f32], out: &mut [f32], from: usize) {
+    for o in from..out.len() {
         let (a, b) = (row[cols.i0[o] as usize], row[cols.i1[o] as usize]);
         out[o] = cols.w[o].mul_add(b - a, a);
     }
@@ -57,18 +54,16 @@ pub(super) unsafe fn columns_avx2(cols: &Columns, row: &[f32], out: &mut [f32]) 
     let mut o = 0;
     // SAFETY: as in `columns_avx512`, 8 at a time.
     unsafe {
-        while o + 8 <= n {
-            let i0 = _mm256_loadu_si256(cols.i0.as_ptr().add(o) as *const __m256i);
-            let i1 = _mm256_loadu_si256(cols.i1.as_ptr().add(o) as *const __m256i);
-            let w = _mm256_loadu_ps(cols.w.as_ptr().add(o));
+        while o < n && n >= 8 {
+            let o0 = o.min(n - 8);
+            let i0 = _mm256_loadu_si256(cols.i0.as_ptr().add(o0) as *const __m256i);
+            let i1 = _mm256_loadu_si256(cols.i1.as_ptr().add(o0) as *const __m256i);
+            let w = _mm256_loadu_ps(cols.w.as_ptr().add(o0));
             let a = _mm256_i32gather_ps::<4>(row.as_ptr(), i0);
             let b = _mm256_i32gather_ps::<4>(row.as_ptr(), i1);
-            _mm256_storeu_ps(out.as_mut_ptr().add(o), _mm256_fmadd_ps(w, _mm256_sub_ps(b, a), a));
-            o += 8;
+            _mm256_storeu_ps(out.as_mut_ptr().add(o0), _mm256_fmadd_ps(w, _mm256_sub_ps(b, a), a));
+            o = o0 + 8;
         }
     }
-    for o in o..n {
-        let (a, b) = (row[cols.i0[o] as usize], row[cols.i1[o] as usize]);
-        out[o] = cols.w[o].mul_add(b - a, a);
-    }
+    scalar_columns(cols, row, out, o);
 }

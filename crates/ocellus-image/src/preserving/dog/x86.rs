@@ -1,44 +1,10 @@
-//! The fused step of the iterative difference of Gaussians with AVX-512 and AVX2, and the
-//! competition alone with AVX-512 (see `dog_step_lanes`).
+//! The fused step of the iterative difference of Gaussians with AVX-512 and AVX2 (see
+//! `dog_step_lanes`).
 
 use super::super::x86::{blocks, blocks_up_to, col_sums, col_sums2, pixel_col_sums, pixel_row_block, row_block};
 use super::super::{Lanes, WideScratch};
 use crate::Plane;
 use std::arch::x86_64::*;
-
-/// `M <- max(0, M + E - I - c)` per lane, as `compete_lanes_generic` (two pixels per
-/// 512-bit register: on `[f32; 8]` pixels LLVM vectorized the loop across pixels, one lane at
-/// a time with gathers and scatters).
-///
-/// # Safety
-/// The CPU must have AVX-512 F and DQ.
-#[target_feature(enable = "avx512f,avx512dq,avx2")]
-pub(in crate::preserving) unsafe fn compete_lanes(
-    maps: &mut Plane<Lanes>,
-    excit: &Plane<Lanes>,
-    inhib: &Plane<Lanes>,
-    c: &Lanes,
-) {
-    // SAFETY: the features were promised by the caller.
-    let (cv, z) = unsafe { (_mm512_broadcast_f32x8(_mm256_loadu_ps(c.as_ptr())), _mm512_setzero_ps()) };
-    for y in 0..maps.height() {
-        let (e, i) = (excit.row(y).as_chunks::<2>(), inhib.row(y).as_chunks::<2>());
-        let (pairs, rest) = maps.row_mut(y).as_chunks_mut::<2>();
-        for ((p, ev), iv) in pairs.iter_mut().zip(e.0).zip(i.0) {
-            let q = p.as_mut_ptr() as *mut f32;
-            // SAFETY: each of `p`, `ev`, `iv` is 16 contiguous floats.
-            unsafe {
-                let (ev, iv) = (_mm512_loadu_ps(ev.as_ptr() as *const f32), _mm512_loadu_ps(iv.as_ptr() as *const f32));
-                _mm512_storeu_ps(q, compete_vector(_mm512_loadu_ps(q), ev, iv, cv, z));
-            }
-        }
-        for ((p, ev), iv) in rest.iter_mut().zip(e.1).zip(i.1) {
-            for l in 0..8 {
-                p[l] = (p[l] + ev[l] - iv[l] - c[l]).max(0.0);
-            }
-        }
-    }
-}
 
 /// `max(0, m + e - i - c)`, the operations of `compete_lanes_generic` in its order.
 #[inline(always)]
@@ -67,7 +33,7 @@ fn fused_fits(
 /// One step of the iterative difference of Gaussians on eight interleaved maps, fused:
 /// `maps <- max(0, maps + E - I - c)` with `E` and `I` the excitatory and inhibitory
 /// energy-preserving filters of `maps` (kernels `ke`, `ki`, vertical taps `re`, `ri`, buffers
-/// `se`, `si`), each output as [`preserving_lanes_avx512`] and [`compete_lanes`] compute
+/// `se`, `si`), each output as [`preserving_lanes_avx512`] and `compete_lanes` compute
 /// it, bit for bit. Why: apart, the two filters each copy every row and build its odd pairs,
 /// write their results, and the competition reads them back; fused, the row is prepared once
 /// (the excitatory kernel, the shorter, reads the inhibitory one's padded pairs), and the
