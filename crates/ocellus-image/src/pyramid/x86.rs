@@ -118,6 +118,37 @@ mod tests {
     }
 }
 
+/// The word permutes of [`split_even_odd_avx512`], fixed for every row and so built at
+/// compile time: per half q = (parity, channel c), the word of output j is word
+/// `6 j + 3 parity + c` of 192 loaded ones; `idx[q][p]` gives its index within loaded vectors
+/// 2p and 2p + 1, `from[q]` the outputs taken from the second and third pair.
+struct SplitTables {
+    idx: [[[i16; 32]; 3]; 6],
+    from: [[u32; 2]; 6],
+}
+
+const SPLIT: SplitTables = {
+    let mut t = SplitTables { idx: [[[0; 32]; 3]; 6], from: [[0; 2]; 6] };
+    let mut q = 0;
+    while q < 6 {
+        let off = 3 * (q / 3) + q % 3;
+        let mut j = 0;
+        while j < 32 {
+            let i = 6 * j + off;
+            t.idx[q][i / 64][j] = (i % 64) as i16;
+            if i >= 64 {
+                t.from[q][0] |= 1 << j;
+            }
+            if i >= 128 {
+                t.from[q][1] |= 1 << j;
+            }
+            j += 1;
+        }
+        q += 1;
+    }
+    t
+};
+
 /// [`super::split_even_odd`] of a row of 16-bit sums: `even[c][k] = row[6 k + c] * scale`,
 /// `odd[c][k] = row[6 k + 3 + c] * scale`. Why by hand: LLVM's form of the six-way split
 /// was a third of the first level's time. Here 32 outputs of each of the six halves come
@@ -140,28 +171,11 @@ pub(super) unsafe fn split_even_odd_avx512(
     if even.iter().any(|e| e.len() < w.div_ceil(2)) || odd.iter().any(|o| o.len() < half) {
         return false;
     }
-    // Per half (c, parity): the word of output j is row[192 b + 6 j + 3 parity + c]; its
-    // index within each pair of loaded vectors, and which pair holds it.
-    let mut idx = [[_mm512_setzero_si512(); 3]; 6];
-    let mut from = [[0u32; 2]; 6];
-    for (q, (ix, m)) in idx.iter_mut().zip(from.iter_mut()).enumerate() {
-        let off = 3 * (q / 3) + q % 3;
-        let mut words = [[0i16; 32]; 3];
-        for j in 0..32 {
-            let i = 6 * j + off;
-            words[i / 64][j] = (i % 64) as i16;
-            if i >= 64 {
-                m[0] |= 1 << j;
-            }
-            if i >= 128 {
-                m[1] |= 1 << j;
-            }
-        }
-        for (v, wds) in ix.iter_mut().zip(&words) {
-            // SAFETY: `wds` holds 32 words.
-            *v = unsafe { _mm512_loadu_si512(wds.as_ptr() as *const _) };
-        }
-    }
+    // SAFETY: each table row holds 32 words.
+    let idx: [[__m512i; 3]; 6] = std::array::from_fn(|q| {
+        std::array::from_fn(|p| unsafe { _mm512_loadu_si512(SPLIT.idx[q][p].as_ptr() as *const _) })
+    });
+    let from = SPLIT.from;
     let [e0, e1, e2] = even;
     let [o0, o1, o2] = odd;
     let outs: [*mut f32; 6] =
