@@ -569,6 +569,13 @@ fn vertical_bytes_u16(src: &Plane<[u8; 3]>, taps: &[(usize, u16)], out: &mut [u1
     }
     let rows = &rows[..taps.len().min(MAX_TAPS)];
     let n = out.len();
+    // The next output row's two new rows, touched one output row ahead (see
+    // `vertical_bytes_u16_avx512`).
+    #[cfg(target_arch = "x86_64")]
+    let ahead = {
+        let last = taps.iter().map(|&(r, _)| r).max().unwrap_or(0);
+        [last + 1, last + 2].map(|r| (r < src.height()).then(|| src.row(r).as_flattened()))
+    };
     // A function, not a closure: closures are not compiled with the caller's target features.
     #[inline(always)]
     fn chunk(rows: &[(&[u8], u16)], x: usize, out: &mut [u16; C]) {
@@ -583,6 +590,13 @@ fn vertical_bytes_u16(src: &Plane<[u8; 3]>, taps: &[(usize, u16)], out: &mut [u1
     }
     let mut x = 0;
     while x + C <= n {
+        #[cfg(target_arch = "x86_64")]
+        for r in ahead.iter().flatten() {
+            if let Some(b) = r.get(x) {
+                // SAFETY: a prefetch only hints the cache, and `b` is inside the row.
+                unsafe { std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(b as *const u8 as *const i8) };
+            }
+        }
         if let Ok(o) = <&mut [u16; C]>::try_from(&mut out[x..x + C]) {
             chunk(rows, x, o);
         }
