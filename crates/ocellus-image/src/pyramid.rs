@@ -594,7 +594,9 @@ fn vertical_bytes_u16(src: &Plane<[u8; 3]>, taps: &[(usize, u16)], out: &mut [u1
         for r in ahead.iter().flatten() {
             if let Some(b) = r.get(x) {
                 // SAFETY: a prefetch only hints the cache, and `b` is inside the row.
-                unsafe { std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(b as *const u8 as *const i8) };
+                unsafe {
+                    std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(b as *const u8 as *const i8)
+                };
             }
         }
         if let Ok(o) = <&mut [u16; C]>::try_from(&mut out[x..x + C]) {
