@@ -2,38 +2,16 @@
 //!
 //! Why by hand: each output reads two table-chosen samples of the row, which the compiler
 //! leaves as scalar loads (about a nanosecond per output on the saliency engine's 42 maps
-//! a frame, 6 % of it). A 512-bit gather reads 16 of them in about 3 ns. Each output is the
-//! generic kernel's `fma(w, b - a, a)`, so the results are the same bit for bit (tested).
+//! a frame, 6 % of it). Each output is the generic kernel's `fma(w, b - a, a)`, so the
+//! results are the same bit for bit (tested).
+//!
+//! 256-bit gathers in every build: a 512-bit form was slower on both cores measured (the
+//! rescaling stage of `bench saliency` 0.068 -> 0.055 ms a frame with the 256-bit one in the
+//! AVX-512 build on an AMD EPYC, Zen 4; an Intel Xeon's AVX2 build rescaled in 0.05 ms
+//! against its AVX-512 build's 0.07).
 
 use super::Columns;
 use std::arch::x86_64::*;
-
-/// `out[o] = fma(w[o], row[i1[o]] - row[i0[o]], row[i0[o]])` for every output, 16 at a time.
-///
-/// # Safety
-/// The CPU must have AVX-512 F (and AVX2, FMA); `cols.max_index < row.len()` and the tables
-/// at least `out.len()` long (the caller checks both).
-#[target_feature(enable = "avx512f,avx2,fma")]
-pub(super) unsafe fn columns_avx512(cols: &Columns, row: &[f32], out: &mut [f32]) {
-    let n = out.len();
-    let mut o = 0;
-    // SAFETY: every index is at most `max_index < row.len()`, and o0 + 16 <= n <= table lengths.
-    unsafe {
-        // 16 at a time, the last 16 aligned to the end (recomputing a few outputs, with the
-        // same values): a 40-wide row would otherwise end in 8 scalar outputs.
-        while o < n && n >= 16 {
-            let o0 = o.min(n - 16);
-            let i0 = _mm512_loadu_si512(cols.i0.as_ptr().add(o0) as *const _);
-            let i1 = _mm512_loadu_si512(cols.i1.as_ptr().add(o0) as *const _);
-            let w = _mm512_loadu_ps(cols.w.as_ptr().add(o0));
-            let a = _mm512_i32gather_ps::<4>(i0, row.as_ptr());
-            let b = _mm512_i32gather_ps::<4>(i1, row.as_ptr());
-            _mm512_storeu_ps(out.as_mut_ptr().add(o0), _mm512_fmadd_ps(w, _mm512_sub_ps(b, a), a));
-            o = o0 + 16;
-        }
-    }
-    scalar_columns(cols, row, out, o);
-}
 
 /// Outputs `from..` of the column step, one at a time (rows shorter than a vector).
 #[inline(always)]
@@ -44,16 +22,19 @@ fn scalar_columns(cols: &Columns, row: &[f32], out: &mut [f32], from: usize) {
     }
 }
 
-/// [`columns_avx512`] with 256-bit gathers, 8 outputs at a time.
+/// `out[o] = fma(w[o], row[i1[o]] - row[i0[o]], row[i0[o]])` for every output, 8 at a time.
 ///
 /// # Safety
-/// The CPU must have AVX2 and FMA; the same bounds as [`columns_avx512`].
+/// The CPU must have AVX2 and FMA; `cols.max_index < row.len()` and the tables at least
+/// `out.len()` long (the caller checks both).
 #[target_feature(enable = "avx2,fma")]
 pub(super) unsafe fn columns_avx2(cols: &Columns, row: &[f32], out: &mut [f32]) {
     let n = out.len();
     let mut o = 0;
-    // SAFETY: as in `columns_avx512`, 8 at a time.
+    // SAFETY: every index is at most `max_index < row.len()`, and o0 + 8 <= n <= table lengths.
     unsafe {
+        // 8 at a time, the last 8 aligned to the end (recomputing a few outputs, with the
+        // same values).
         while o < n && n >= 8 {
             let o0 = o.min(n - 8);
             let i0 = _mm256_loadu_si256(cols.i0.as_ptr().add(o0) as *const __m256i);
