@@ -39,6 +39,9 @@ struct Columns {
     w: Vec<f32>,
     /// The largest index of either column (the row must be longer).
     max_index: usize,
+    /// Both columns never decrease and `i0 <= i1` (true of every table built here): the
+    /// samples of a run of outputs then lie between its first `i0` and its last `i1`.
+    monotonic: bool,
 }
 
 impl Columns {
@@ -48,11 +51,14 @@ impl Columns {
         if i32::try_from(max_index).is_err() {
             return Self::default();
         }
+        let monotonic =
+            xs.iter().all(|&(a, b, _)| a <= b) && xs.windows(2).all(|p| p[0].0 <= p[1].0 && p[0].1 <= p[1].1);
         Self {
             i0: xs.iter().map(|&(a, _, _)| a as i32).collect(),
             i1: xs.iter().map(|&(_, b, _)| b as i32).collect(),
             w: xs.iter().map(|&(_, _, w)| w).collect(),
             max_index,
+            monotonic,
         }
     }
 }
@@ -159,11 +165,14 @@ fn resample_generic<M: Madd>(
         let out = dst.row_mut(y);
         #[cfg(target_arch = "x86_64")]
         if M::AVX2 && cols.max_index < row.len() && cols.i0.len() >= out.len() {
-            // SAFETY: `M::AVX2` is true only inside kernels compiled for AVX2 and FMA (or
-            // AVX-512), which `dispatch_kernel!` calls only on CPUs that have them; the bounds
-            // are checked just above. The AVX-512 build takes the 256-bit gathers too (see
-            // `resample/x86.rs`).
-            unsafe { x86::columns_avx2(cols, row, out) };
+            // SAFETY: `M::AVX2` (`M::AVX512`) is true only inside kernels compiled for AVX2
+            // and FMA (AVX-512 F/BW/VL/DQ), which `dispatch_kernel!` calls only on CPUs that
+            // have them; the bounds are checked just above.
+            unsafe {
+                if !(M::AVX512 && x86::columns_permute_avx512(cols, row, out)) {
+                    x86::columns_avx2(cols, row, out);
+                }
+            }
             continue;
         }
         let _ = cols;
@@ -206,8 +215,8 @@ pub fn resize(backend: Backend, src: &Plane<f32>, w: usize, h: usize, method: Re
 mod tests {
     use super::*;
 
-    /// The gathering kernel gives the generic kernel's results bit for bit, downsampling and
-    /// upsampling, on widths around its vector length.
+    /// The gathering and permuting kernels give the generic kernel's results bit for bit,
+    /// downsampling and upsampling, on widths around their vector lengths.
     #[cfg(target_arch = "x86_64")]
     #[test]
     fn gathering_kernels_equal_the_generic_kernel_bit_for_bit() {
@@ -215,7 +224,19 @@ mod tests {
             return;
         }
         let mut rng = crate::rng::SplitMix64::new(3);
-        for (sw, sh, dw, dh) in [(160, 120, 40, 30), (20, 15, 40, 30), (5, 3, 40, 30), (2, 1, 7, 3), (33, 9, 17, 5)] {
+        // Windows of 16 outputs within 32 and 64 samples, and wider (1280 -> 40: gathers), rows
+        // ending inside the last window, and the nearest-neighbour tables.
+        for (sw, sh, dw, dh) in [
+            (160, 120, 40, 30),
+            (80, 60, 40, 30),
+            (20, 15, 40, 30),
+            (5, 3, 40, 30),
+            (2, 1, 7, 3),
+            (33, 9, 17, 5),
+            (1280, 4, 40, 3),
+            (1, 2, 19, 2),
+            (47, 3, 61, 2),
+        ] {
             let src = Plane::from_fn(sw, sh, |_, _| rng.unit() as f32);
             let r = Resampler::new(ResampleMethod::Bilinear, (sw, sh), (dw, dh)).unwrap_or_else(|e| panic!("{e}"));
             let mut want = Plane::new(dw, dh);
@@ -233,6 +254,14 @@ mod tests {
                 unsafe { x86::columns_avx2(&r.cols, &row, &mut out) };
                 let same = out.iter().zip(want.row(y)).all(|(a, b)| a.to_bits() == b.to_bits());
                 assert!(same, "{sw}x{sh} -> {dw}x{dh}, row {y}");
+                if crate::simd::avx512_available() {
+                    let mut out = vec![f32::NAN; dw];
+                    // SAFETY: AVX-512 was checked just above; the same bounds.
+                    let ran = unsafe { x86::columns_permute_avx512(&r.cols, &row, &mut out) };
+                    assert_eq!(ran, dw >= 16, "{sw}x{sh} -> {dw}x{dh}");
+                    let same = !ran || out.iter().zip(want.row(y)).all(|(a, b)| a.to_bits() == b.to_bits());
+                    assert!(same, "{sw}x{sh} -> {dw}x{dh}, row {y} (permutes)");
+                }
             }
         }
     }

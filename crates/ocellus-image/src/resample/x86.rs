@@ -5,10 +5,11 @@
 //! a frame, 6 % of it). Each output is the generic kernel's `fma(w, b - a, a)`, so the
 //! results are the same bit for bit (tested).
 //!
-//! 256-bit gathers in every build: a 512-bit form was slower on both cores measured (the
-//! rescaling stage of `bench saliency` 0.068 -> 0.055 ms a frame with the 256-bit one in the
-//! AVX-512 build on an AMD EPYC, Zen 4; an Intel Xeon's AVX2 build rescaled in 0.05 ms
-//! against its AVX-512 build's 0.07).
+//! With AVX-512 the samples of 16 outputs usually lie within 64 of the row (every
+//! upsampling, and downsampling by up to 4: all of the saliency engine's rescaling), so
+//! four loads and two-source permutes pick them ([`columns_permute_avx512`]); a gather is
+//! slow (a 512-bit one was slower than two 256-bit ones on both cores measured: the
+//! rescaling stage of `bench saliency` 0.068 -> 0.055 ms a frame on an AMD EPYC, Zen 4).
 
 use super::Columns;
 use std::arch::x86_64::*;
@@ -47,4 +48,76 @@ pub(super) unsafe fn columns_avx2(cols: &Columns, row: &[f32], out: &mut [f32]) 
         }
     }
     scalar_columns(cols, row, out, o);
+}
+
+/// [`columns_avx2`] with permutes: per 16 outputs, when their samples lie within 64 of the
+/// row (from the block's first `i0`), the four vectors there (masked at the row's end) and
+/// two-source permutes give both samples of each output; a wider block takes two 256-bit
+/// gathers. The same `fma(w, b - a, a)`, so the same bits (tested). False (nothing written)
+/// for fewer than 16 outputs or tables that are not monotonic.
+///
+/// # Safety
+/// The CPU must have AVX-512 F and DQ (and AVX2, FMA); `cols.max_index < row.len()` and the
+/// tables at least `out.len()` long (the caller checks both).
+#[target_feature(enable = "avx512f,avx512dq,avx2,fma")]
+pub(super) unsafe fn columns_permute_avx512(cols: &Columns, row: &[f32], out: &mut [f32]) -> bool {
+    let n = out.len();
+    if n < 16 || !cols.monotonic {
+        return false;
+    }
+    let len = row.len();
+    // The row's floats from `start`, 16 of them, those past its end as zeros (a masked load
+    // reads nothing there).
+    #[inline(always)]
+    unsafe fn window(row: &[f32], start: usize) -> __m512 {
+        let left = row.len().saturating_sub(start);
+        let mask: __mmask16 = if left >= 16 { 0xFFFF } else { ((1u32 << left) - 1) as __mmask16 };
+        // SAFETY: the lanes read are the mask's, all inside the row.
+        unsafe { _mm512_maskz_loadu_ps(mask, row.as_ptr().wrapping_add(start)) }
+    }
+    /// The samples at offsets `r` (0..64) of the window `v`: index bits 0-4 choose within a
+    /// pair of vectors, bit 5 the pair. (Functions, not closures, so that they are compiled
+    /// with the caller's target features.)
+    #[inline(always)]
+    unsafe fn pick(v: &[__m512; 4], r: __m512i) -> __m512 {
+        // SAFETY: register operations only; the caller has AVX-512 F.
+        unsafe {
+            let lo = _mm512_permutex2var_ps(v[0], r, v[1]);
+            let hi = _mm512_permutex2var_ps(v[2], r, v[3]);
+            _mm512_mask_blend_ps(_mm512_cmpge_epi32_mask(r, _mm512_set1_epi32(32)), lo, hi)
+        }
+    }
+    /// The samples at indices `i` of the row, by two 256-bit gathers.
+    #[inline(always)]
+    unsafe fn gather(row: &[f32], i: __m512i) -> __m512 {
+        // SAFETY: the caller keeps every index inside the row; it has AVX-512 F and DQ.
+        unsafe {
+            let lo = _mm256_i32gather_ps::<4>(row.as_ptr(), _mm512_castsi512_si256(i));
+            let hi = _mm256_i32gather_ps::<4>(row.as_ptr(), _mm512_extracti64x4_epi64::<1>(i));
+            _mm512_insertf32x8::<1>(_mm512_castps256_ps512(lo), hi)
+        }
+    }
+    let mut o = 0;
+    // SAFETY: o0 + 16 <= n <= table lengths; every index is at most `max_index < len`, and
+    // the window's loads are masked to the row.
+    unsafe {
+        while o < n {
+            let o0 = o.min(n - 16);
+            let base = cols.i0[o0] as usize;
+            let top = cols.i1[o0 + 15] as usize;
+            let w = _mm512_loadu_ps(cols.w.as_ptr().add(o0));
+            let i0 = _mm512_loadu_si512(cols.i0.as_ptr().add(o0) as *const _);
+            let i1 = _mm512_loadu_si512(cols.i1.as_ptr().add(o0) as *const _);
+            let (a, b) = if top < base + 64 && top < len {
+                let v = [window(row, base), window(row, base + 16), window(row, base + 32), window(row, base + 48)];
+                let start = _mm512_set1_epi32(base as i32);
+                (pick(&v, _mm512_sub_epi32(i0, start)), pick(&v, _mm512_sub_epi32(i1, start)))
+            } else {
+                (gather(row, i0), gather(row, i1))
+            };
+            _mm512_storeu_ps(out.as_mut_ptr().add(o0), _mm512_fmadd_ps(w, _mm512_sub_ps(b, a), a));
+            o = o0 + 16;
+        }
+    }
+    true
 }
