@@ -64,6 +64,10 @@ struct Pair([f32; 16]);
 #[derive(Clone, Debug, Default)]
 struct WideScratch {
     off: usize,
+    /// One past the highest row any vertical tap of the filter's `rows` reads (0 without
+    /// taps), found when both were built: the rows never change after that, and the kernels
+    /// take this scratch only with the rows of the filter that owns it.
+    taps_below: usize,
     even: Vec<Pair>,
     odd: Vec<Pair>,
     tmp: Vec<Pair>,
@@ -93,9 +97,9 @@ impl PreservingFilter {
                 r.iter_mut().for_each(|(_, w)| *w *= f);
                 r
             })
-            .collect();
+            .collect::<Vec<Vec<(usize, f32)>>>();
         #[cfg(target_arch = "x86_64")]
-        let wide = WideScratch::new(width, height, hw, &fx);
+        let wide = WideScratch::new(width, height, hw, &fx, &rows);
         #[cfg(not(target_arch = "x86_64"))]
         let wide = WideScratch::default();
         Ok(Self {
