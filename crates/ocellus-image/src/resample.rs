@@ -169,7 +169,12 @@ fn resample_generic<M: Madd>(
             // and FMA (AVX-512 F/BW/VL/DQ), which `dispatch_kernel!` calls only on CPUs that
             // have them; the bounds are checked just above.
             unsafe {
-                if !(M::AVX512 && x86::columns_permute_avx512(cols, row, out)) {
+                let done = if M::AVX512 {
+                    x86::columns_permute_avx512(cols, row, out)
+                } else {
+                    x86::columns_permute_avx2(cols, row, out)
+                };
+                if !done {
                     x86::columns_avx2(cols, row, out);
                 }
             }
@@ -254,6 +259,12 @@ mod tests {
                 unsafe { x86::columns_avx2(&r.cols, &row, &mut out) };
                 let same = out.iter().zip(want.row(y)).all(|(a, b)| a.to_bits() == b.to_bits());
                 assert!(same, "{sw}x{sh} -> {dw}x{dh}, row {y}");
+                let mut out = vec![f32::NAN; dw];
+                // SAFETY: AVX2 was checked above; the same bounds.
+                let ran = unsafe { x86::columns_permute_avx2(&r.cols, &row, &mut out) };
+                assert_eq!(ran, dw >= 8, "{sw}x{sh} -> {dw}x{dh}");
+                let same = !ran || out.iter().zip(want.row(y)).all(|(a, b)| a.to_bits() == b.to_bits());
+                assert!(same, "{sw}x{sh} -> {dw}x{dh}, row {y} (256-bit permutes)");
                 if crate::simd::avx512_available() {
                     let mut out = vec![f32::NAN; dw];
                     // SAFETY: AVX-512 was checked just above; the same bounds.
