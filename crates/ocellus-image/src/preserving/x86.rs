@@ -111,7 +111,7 @@ impl WideScratch {
         let pairs = w.div_ceil(2);
         if pairs == 0
             || self.odd.len() + 1 != self.even.len()
-            || self.off % 2 != 0
+            || !self.off.is_multiple_of(2)
             || base + pairs + 1 > self.even.len()
         {
             return;
