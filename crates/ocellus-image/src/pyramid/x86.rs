@@ -43,12 +43,7 @@ pub(super) unsafe fn vertical_bytes_u16_avx512(src: &Plane<[u8; 3]>, taps: &[(us
         np += 1;
     }
     let pairs = &pairs[..np];
-    // The next output row reads two rows below these; on a frame that is not in cache
-    // (640x480 RGB is 0.9 MB) the first read of each row waited on memory (about a third of
-    // the level's time on an AMD EPYC, Zen 4). Touching them one output row ahead hides it.
-    let last = taps.iter().map(|&(r, _)| r).max().unwrap_or(0);
-    let ahead = |d: usize| (last + d < src.height()).then(|| src.row(last + d).as_flattened().as_ptr());
-    let ahead = [ahead(1), ahead(2)];
+    let ahead = super::rows_ahead(src, taps);
     // unpacklo/hi interleave within 128-bit blocks: the sums of block k of the low half hold
     // values 16k..16k+8 of the 64, the high half's 16k+8..16k+16; these put them in order.
     let first = _mm512_set_epi64(11, 10, 3, 2, 9, 8, 1, 0);
@@ -59,7 +54,7 @@ pub(super) unsafe fn vertical_bytes_u16_avx512(src: &Plane<[u8; 3]>, taps: &[(us
     unsafe {
         while x + 64 <= n {
             for r in ahead.iter().flatten() {
-                _mm_prefetch::<_MM_HINT_T0>(r.add(x) as *const i8);
+                _mm_prefetch::<_MM_HINT_T0>(r.as_ptr().add(x) as *const i8);
             }
             chunk(pairs, o, x, first, second);
             x += 64;

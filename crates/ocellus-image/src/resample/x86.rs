@@ -8,53 +8,27 @@
 //! With AVX-512 the samples of 16 outputs usually lie within 64 of the row (every
 //! upsampling, and downsampling by up to 4: all of the saliency engine's rescaling), so
 //! four loads and two-source permutes pick them ([`columns_permute_avx512`]); with AVX2 those
-//! of 8 within 16 ([`columns_permute_avx2`], up to a factor of 2). A gather is slow (a 512-bit one was slower than two 256-bit ones on both cores measured: the
+//! of 8 within 16 ([`columns_avx2`], up to a factor of 2). Other blocks take gathers, which
+//! are slow (a 512-bit one was slower than two 256-bit ones on both cores measured: the
 //! rescaling stage of `bench saliency` 0.068 -> 0.055 ms a frame on an AMD EPYC, Zen 4).
 
 use super::Columns;
 use std::arch::x86_64::*;
 
-/// Outputs `from..` of the column step, one at a time (rows shorter than a vector).
+/// The column step one output at a time (rows shorter than a vector).
 #[inline(always)]
-fn scalar_columns(cols: &Columns, row: &[f32], out: &mut [f32], from: usize) {
-    for o in from..out.len() {
+fn scalar_columns(cols: &Columns, row: &[f32], out: &mut [f32]) {
+    for o in 0..out.len() {
         let (a, b) = (row[cols.i0[o] as usize], row[cols.i1[o] as usize]);
         out[o] = cols.w[o].mul_add(b - a, a);
     }
 }
 
-/// `out[o] = fma(w[o], row[i1[o]] - row[i0[o]], row[i0[o]])` for every output, 8 at a time.
-///
-/// # Safety
-/// The CPU must have AVX2 and FMA; `cols.max_index < row.len()` and the tables at least
-/// `out.len()` long (the caller checks both).
-#[target_feature(enable = "avx2,fma")]
-pub(super) unsafe fn columns_avx2(cols: &Columns, row: &[f32], out: &mut [f32]) {
-    let n = out.len();
-    let mut o = 0;
-    // SAFETY: every index is at most `max_index < row.len()`, and o0 + 8 <= n <= table lengths.
-    unsafe {
-        // 8 at a time, the last 8 aligned to the end (recomputing a few outputs, with the
-        // same values).
-        while o < n && n >= 8 {
-            let o0 = o.min(n - 8);
-            let i0 = _mm256_loadu_si256(cols.i0.as_ptr().add(o0) as *const __m256i);
-            let i1 = _mm256_loadu_si256(cols.i1.as_ptr().add(o0) as *const __m256i);
-            let w = _mm256_loadu_ps(cols.w.as_ptr().add(o0));
-            let a = _mm256_i32gather_ps::<4>(row.as_ptr(), i0);
-            let b = _mm256_i32gather_ps::<4>(row.as_ptr(), i1);
-            _mm256_storeu_ps(out.as_mut_ptr().add(o0), _mm256_fmadd_ps(w, _mm256_sub_ps(b, a), a));
-            o = o0 + 8;
-        }
-    }
-    scalar_columns(cols, row, out, o);
-}
-
-/// [`columns_avx2`] with permutes: per 16 outputs, when their samples lie within 64 of the
+/// [`columns_avx2`] with 512-bit registers: per 16 outputs, when their samples lie within 64 of the
 /// row (from the block's first `i0`), the four vectors there (masked at the row's end) and
 /// two-source permutes give both samples of each output; a wider block takes two 256-bit
-/// gathers. The same `fma(w, b - a, a)`, so the same bits (tested). False (nothing written)
-/// for fewer than 16 outputs or tables that are not monotonic.
+/// gathers (every block, for tables that are not monotonic). The same `fma(w, b - a, a)`, so
+/// the same bits (tested). False (nothing written) for fewer than 16 outputs.
 ///
 /// # Safety
 /// The CPU must have AVX-512 F and DQ (and AVX2, FMA); `cols.max_index < row.len()` and the
@@ -62,7 +36,7 @@ pub(super) unsafe fn columns_avx2(cols: &Columns, row: &[f32], out: &mut [f32]) 
 #[target_feature(enable = "avx512f,avx512dq,avx2,fma")]
 pub(super) unsafe fn columns_permute_avx512(cols: &Columns, row: &[f32], out: &mut [f32]) -> bool {
     let n = out.len();
-    if n < 16 || !cols.monotonic {
+    if n < 16 {
         return false;
     }
     let len = row.len();
@@ -108,7 +82,7 @@ pub(super) unsafe fn columns_permute_avx512(cols: &Columns, row: &[f32], out: &m
             let w = _mm512_loadu_ps(cols.w.as_ptr().add(o0));
             let i0 = _mm512_loadu_si512(cols.i0.as_ptr().add(o0) as *const _);
             let i1 = _mm512_loadu_si512(cols.i1.as_ptr().add(o0) as *const _);
-            let (a, b) = if top < base + 64 && top < len {
+            let (a, b) = if cols.monotonic && top < base + 64 && top < len {
                 let v = [window(row, base), window(row, base + 16), window(row, base + 32), window(row, base + 48)];
                 let start = _mm512_set1_epi32(base as i32);
                 (pick(&v, _mm512_sub_epi32(i0, start)), pick(&v, _mm512_sub_epi32(i1, start)))
@@ -122,20 +96,22 @@ pub(super) unsafe fn columns_permute_avx512(cols: &Columns, row: &[f32], out: &m
     true
 }
 
-/// [`columns_permute_avx512`] with 256-bit registers: per 8 outputs, when their samples lie
-/// within 16 of the row (every upsampling and downsampling by up to 2), two loads (masked at
-/// the row's end) and in-lane permutes give both samples of each output; a wider block takes
-/// two gathers. The same `fma(w, b - a, a)`, so the same bits (tested). False (nothing
-/// written) for fewer than 8 outputs or tables that are not monotonic.
+/// `out[o] = fma(w[o], row[i1[o]] - row[i0[o]], row[i0[o]])` for every output, 8 at a time
+/// (the last 8 aligned to the end, recomputing a few outputs with the same values; shorter
+/// rows one at a time): when the samples of 8 outputs lie within 16 of the row (every
+/// upsampling and downsampling by up to 2), two loads (masked at the row's end) and in-lane
+/// permutes give both samples of each output; other blocks, and every block of tables that
+/// are not monotonic, take two gathers. The generic kernel's results bit for bit (tested).
 ///
 /// # Safety
 /// The CPU must have AVX2 and FMA; `cols.max_index < row.len()` and the tables at least
 /// `out.len()` long (the caller checks both).
 #[target_feature(enable = "avx2,fma")]
-pub(super) unsafe fn columns_permute_avx2(cols: &Columns, row: &[f32], out: &mut [f32]) -> bool {
+pub(super) unsafe fn columns_avx2(cols: &Columns, row: &[f32], out: &mut [f32]) {
     let n = out.len();
-    if n < 8 || !cols.monotonic {
-        return false;
+    if n < 8 {
+        scalar_columns(cols, row, out);
+        return;
     }
     /// The row's floats from `start`, 8 of them, those past its end as zeros (a masked load
     /// reads nothing there).
@@ -170,7 +146,7 @@ pub(super) unsafe fn columns_permute_avx2(cols: &Columns, row: &[f32], out: &mut
             let w = _mm256_loadu_ps(cols.w.as_ptr().add(o0));
             let i0 = _mm256_loadu_si256(cols.i0.as_ptr().add(o0) as *const __m256i);
             let i1 = _mm256_loadu_si256(cols.i1.as_ptr().add(o0) as *const __m256i);
-            let (a, b) = if top < base + 16 && top < len {
+            let (a, b) = if cols.monotonic && top < base + 16 && top < len {
                 let v = [window(row, base), window(row, base + 8)];
                 let start = _mm256_set1_epi32(base as i32);
                 (pick(v, _mm256_sub_epi32(i0, start)), pick(v, _mm256_sub_epi32(i1, start)))
@@ -181,5 +157,4 @@ pub(super) unsafe fn columns_permute_avx2(cols: &Columns, row: &[f32], out: &mut
             o = o0 + 8;
         }
     }
-    true
 }
