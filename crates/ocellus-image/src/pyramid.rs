@@ -438,9 +438,15 @@ fn pyr_down_rgb8_generic<M: Madd>(
             let mut d = d_inner;
             taps_at(j, inner, &s.itaps_interior, &mut s.itaps, |t| d = ik.taps_for(kernel, j, h, &mut s.taps, t));
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `M::AVX512` is true only inside kernels compiled for AVX-512 (F/BW/VL/DQ),
-            // which `dispatch_kernel!` calls only on CPUs that have it.
-            let done = M::AVX512 && unsafe { x86::vertical_bytes_u16_avx512(src, &s.itaps, &mut s.row16) };
+            // SAFETY: `M::AVX512` (`M::AVX2`) is true only inside kernels compiled for AVX-512
+            // F/BW/VL/DQ (AVX2 and FMA), which `dispatch_kernel!` calls only on CPUs that have it.
+            let done = unsafe {
+                if M::AVX512 {
+                    x86::vertical_bytes_u16_avx512(src, &s.itaps, &mut s.row16)
+                } else {
+                    M::AVX2 && x86::vertical_bytes_u16_avx2(src, &s.itaps, &mut s.row16)
+                }
+            };
             #[cfg(not(target_arch = "x86_64"))]
             let done = false;
             if !done {
@@ -449,15 +455,14 @@ fn pyr_down_rgb8_generic<M: Madd>(
             let scale = 1.0 / (d as f32 * 255.0);
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as above.
-            let split = M::AVX512
-                && unsafe {
-                    x86::split_even_odd_avx512(
-                        &s.row16,
-                        scale,
-                        [&mut *e0, &mut *e1, &mut *e2],
-                        [&mut *o0, &mut *o1, &mut *o2],
-                    )
-                };
+            let split = unsafe {
+                let (even, odd) = ([&mut *e0, &mut *e1, &mut *e2], [&mut *o0, &mut *o1, &mut *o2]);
+                if M::AVX512 {
+                    x86::split_even_odd_avx512(&s.row16, scale, even, odd)
+                } else {
+                    M::AVX2 && x86::split_even_odd_avx2(&s.row16, scale, even, odd)
+                }
+            };
             #[cfg(not(target_arch = "x86_64"))]
             let split = false;
             if !split {
