@@ -11,6 +11,42 @@
 use crate::Plane;
 use std::arch::x86_64::*;
 
+/// Most pairs of tap rows the byte kernels take (16 taps, [`super::MAX_TAPS`]).
+const MAX_PAIRS: usize = 8;
+
+/// The taps two by two for `vpmaddubsw`: per pair the two rows' bytes and the weight word
+/// `(kb << 8) | ka` (little-endian: the low byte of each 16-bit lane, row a's byte, takes
+/// ka); an odd one out pairs with itself at weight 0. With the number of pairs; `None` when
+/// a weight exceeds 127, a pair's weights 128 (a pair's sum must fit a signed 16-bit lane),
+/// a row is outside `src`, there are more than 16 taps, or `n` (the values to sum) is below
+/// `min_n` or above the row's.
+#[allow(clippy::type_complexity)]
+fn row_pairs(
+    src: &Plane<[u8; 3]>,
+    taps: &[(usize, u16)],
+    n: usize,
+    min_n: usize,
+) -> Option<([(*const u8, *const u8, i16); MAX_PAIRS], usize)> {
+    if taps.is_empty() || taps.len() > 2 * MAX_PAIRS || n < min_n || n > src.width() * 3 {
+        return None;
+    }
+    if taps.iter().any(|&(r, k)| k > 127 || r >= src.height()) {
+        return None;
+    }
+    let mut pairs = [(std::ptr::null(), std::ptr::null(), 0i16); MAX_PAIRS];
+    let mut np = 0;
+    for ch in taps.chunks(2) {
+        let (ra, ka) = ch[0];
+        let (rb, kb) = ch.get(1).copied().unwrap_or((ra, 0));
+        if ka + kb > 128 {
+            return None;
+        }
+        pairs[np] = (src.row(ra).as_flattened().as_ptr(), src.row(rb).as_flattened().as_ptr(), ((kb << 8) | ka) as i16);
+        np += 1;
+    }
+    Some((pairs, np))
+}
+
 /// `out[x] = sum_t w_t row_t[x]` over the interleaved bytes of `src`'s rows `taps` (`out` is
 /// `3 w` long), as `vertical_bytes_u16`. False (nothing written) when a weight exceeds 127,
 /// a pair of weights 128 (a pair's sum must fit a signed 16-bit lane), there are more than
@@ -20,29 +56,9 @@ use std::arch::x86_64::*;
 /// The CPU must have AVX-512 F and BW.
 #[target_feature(enable = "avx512f,avx512bw,avx2")]
 pub(super) unsafe fn vertical_bytes_u16_avx512(src: &Plane<[u8; 3]>, taps: &[(usize, u16)], out: &mut [u16]) -> bool {
-    const MAX_PAIRS: usize = 8;
     let n = out.len();
-    if taps.is_empty() || taps.len() > 2 * MAX_PAIRS || n < 64 || n > src.width() * 3 {
-        return false;
-    }
-    if taps.iter().any(|&(r, k)| k > 127 || r >= src.height()) {
-        return false;
-    }
-    // Taps two by two; an odd one out pairs with itself at weight 0.
-    let mut pairs: [(*const u8, *const u8, __m512i); MAX_PAIRS] =
-        [(std::ptr::null(), std::ptr::null(), _mm512_setzero_si512()); MAX_PAIRS];
-    let mut np = 0;
-    for ch in taps.chunks(2) {
-        let (ra, ka) = ch[0];
-        let (rb, kb) = ch.get(1).copied().unwrap_or((ra, 0));
-        if ka + kb > 128 {
-            return false;
-        }
-        // Little-endian: the low byte of each 16-bit lane (row a's byte) takes ka.
-        let w = _mm512_set1_epi16(((kb << 8) | ka) as i16);
-        pairs[np] = (src.row(ra).as_flattened().as_ptr(), src.row(rb).as_flattened().as_ptr(), w);
-        np += 1;
-    }
+    let Some((rows, np)) = row_pairs(src, taps, n, 64) else { return false };
+    let pairs: [(*const u8, *const u8, __m512i); MAX_PAIRS] = rows.map(|(a, b, w)| (a, b, _mm512_set1_epi16(w)));
     let pairs = &pairs[..np];
     let ahead = super::rows_ahead(src, taps);
     // unpacklo/hi interleave within 128-bit blocks: the sums of block k of the low half hold
@@ -94,27 +110,9 @@ unsafe fn chunk(pairs: &[(*const u8, *const u8, __m512i)], o: *mut u16, x: usize
 /// The CPU must have AVX2.
 #[target_feature(enable = "avx2")]
 pub(super) unsafe fn vertical_bytes_u16_avx2(src: &Plane<[u8; 3]>, taps: &[(usize, u16)], out: &mut [u16]) -> bool {
-    const MAX_PAIRS: usize = 8;
     let n = out.len();
-    if taps.is_empty() || taps.len() > 2 * MAX_PAIRS || n < 32 || n > src.width() * 3 {
-        return false;
-    }
-    if taps.iter().any(|&(r, k)| k > 127 || r >= src.height()) {
-        return false;
-    }
-    let mut pairs: [(*const u8, *const u8, __m256i); MAX_PAIRS] =
-        [(std::ptr::null(), std::ptr::null(), _mm256_setzero_si256()); MAX_PAIRS];
-    let mut np = 0;
-    for ch in taps.chunks(2) {
-        let (ra, ka) = ch[0];
-        let (rb, kb) = ch.get(1).copied().unwrap_or((ra, 0));
-        if ka + kb > 128 {
-            return false;
-        }
-        let w = _mm256_set1_epi16(((kb << 8) | ka) as i16);
-        pairs[np] = (src.row(ra).as_flattened().as_ptr(), src.row(rb).as_flattened().as_ptr(), w);
-        np += 1;
-    }
+    let Some((rows, np)) = row_pairs(src, taps, n, 32) else { return false };
+    let pairs: [(*const u8, *const u8, __m256i); MAX_PAIRS] = rows.map(|(a, b, w)| (a, b, _mm256_set1_epi16(w)));
     let pairs = &pairs[..np];
     let ahead = super::rows_ahead(src, taps);
     let o = out.as_mut_ptr();
