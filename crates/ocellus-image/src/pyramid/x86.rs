@@ -287,10 +287,24 @@ pub(super) unsafe fn split_even_odd_avx512(
             }
         }
     }
-    for k in 32 * blocks..half {
+    // SAFETY: the halves were checked above.
+    unsafe { split_tail(row, scale, outs, 32 * blocks) };
+    true
+}
+
+/// The split's outputs from `k0` on, one at a time, and the last pixel of an odd row: the
+/// generic loop's products.
+///
+/// # Safety
+/// `outs` are the even halves (at least `ceil(w / 2)` values, w = `row.len() / 3`) then the
+/// odd ones (at least `w / 2`).
+#[inline(always)]
+unsafe fn split_tail(row: &[u16], scale: f32, outs: [*mut f32; 6], k0: usize) {
+    let w = row.len() / 3;
+    for k in k0..w / 2 {
         let px = &row[6 * k..6 * k + 6];
         for c in 0..3 {
-            // SAFETY: k < half <= every half's length (checked above).
+            // SAFETY: k < w / 2 <= every half's length.
             unsafe {
                 *outs[c].add(k) = px[c] as f32 * scale;
                 *outs[3 + c].add(k) = px[3 + c] as f32 * scale;
@@ -300,11 +314,10 @@ pub(super) unsafe fn split_even_odd_avx512(
     if w % 2 == 1 {
         let last = &row[3 * (w - 1)..3 * w];
         for c in 0..3 {
-            // SAFETY: the even halves hold ceil(w / 2) values (checked above).
+            // SAFETY: the even halves hold ceil(w / 2) values.
             unsafe { *outs[c].add(w / 2) = last[c] as f32 * scale };
         }
     }
-    true
 }
 
 /// [`split_even_odd_avx512`] with 256-bit registers: 8 outputs of each of the six halves
@@ -368,23 +381,8 @@ pub(super) unsafe fn split_even_odd_avx2(row: &[u16], scale: f32, even: [&mut [f
             }
         }
     }
-    for k in 8 * blocks..half {
-        let px = &row[6 * k..6 * k + 6];
-        for c in 0..3 {
-            // SAFETY: k < half <= every half's length (checked above).
-            unsafe {
-                *outs[c].add(k) = px[c] as f32 * scale;
-                *outs[3 + c].add(k) = px[3 + c] as f32 * scale;
-            }
-        }
-    }
-    if w % 2 == 1 {
-        let last = &row[3 * (w - 1)..3 * w];
-        for c in 0..3 {
-            // SAFETY: the even halves hold ceil(w / 2) values (checked above).
-            unsafe { *outs[c].add(w / 2) = last[c] as f32 * scale };
-        }
-    }
+    // SAFETY: the halves were checked above.
+    unsafe { split_tail(row, scale, outs, 8 * blocks) };
     true
 }
 
