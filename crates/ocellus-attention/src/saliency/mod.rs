@@ -22,7 +22,7 @@ use ocellus_image::resample::{ResampleMethod, Resampler};
 use ocellus_image::{Backend, Plane};
 use std::time::{Duration, Instant};
 
-/// The fewest feature maps that N(.) takes as one batch of eight SIMD lanes: a batch costs
+/// The fewest maps that N(.) takes as one batch of eight SIMD lanes: a batch costs
 /// the same however few lanes it fills, about four single maps with the AVX2 kernels on 40x30
 /// maps (AMD EPYC, Zen 3: 71 against 18 us, the fastest of 600 timings of ten calls each).
 /// The 42 maps of the standard channels go as five batches and two single maps.
@@ -559,8 +559,8 @@ impl SaliencyEngine {
         }
     }
 
-    /// N(.) on the feature maps: eight at a time in SIMD lanes, the last few (fewer than
-    /// [`LANES_FROM`]) one by one. Each lane gets the treatment of a single map (equal within
+    /// N(.) on the feature maps, then on the sub-feature sums: eight at a time in SIMD lanes,
+    /// the last few of each (fewer than [`LANES_FROM`]) one by one. Each lane gets the treatment of a single map (equal within
     /// rounding, tested in `ocellus-image`), but a batch costs the same however few lanes it
     /// fills.
     fn normalize_and_combine(&mut self) -> Result<(Duration, Duration)> {
@@ -594,6 +594,12 @@ impl SaliencyEngine {
         // Sub-feature sums: N without rescaling, in place.
         let ns = self.sub_sums.len();
         for start in (0..ns).step_by(8) {
+            if ns - start < LANES_FROM {
+                for m in &mut self.sub_sums[start..] {
+                    self.normalizer.apply(b, m, None)?;
+                }
+                break;
+            }
             let maps: [Option<&Plane<f32>>; 8] = std::array::from_fn(|l| self.sub_sums.get(start + l));
             interleave(&maps, &mut self.lanes);
             self.normalizer.apply_lanes(b, &mut self.lanes, None)?;

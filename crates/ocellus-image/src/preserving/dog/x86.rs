@@ -175,14 +175,19 @@ pub(in crate::preserving) unsafe fn dog_step_avx2(
 ) -> bool {
     let (w, h) = maps.size();
     let Some((first_i, first_e, npair)) = fused_fits((ke, re, se), (ki, ri, si), maps) else { return false };
-    let (step, wide) = if w >= 8 { (8, true) } else { (1, false) };
     // Both passes in blocks of 10 pixels where the row has them: 10 chains of multiply-adds
     // in flight instead of 8 (whose 4-cycle latency two pipes just cover), which on a
     // 40-pixel map is 4 blocks instead of 5: the step about 2 % faster for the horizontal
     // pass and 1 % more for the vertical one on an AMD EPYC (Zen 3; as the AVX-512 kernel's
     // blocks of 10 pairs). Two map rows at a time in the vertical pass, as the AVX-512
     // kernel does, was no faster here.
-    let block = if w >= 10 { 10 } else { step };
+    let block = if w >= 10 {
+        10
+    } else if w >= 8 {
+        8
+    } else {
+        1
+    };
     for y in 0..h {
         si.load_row(maps.row(y));
         let e = si.even.as_ptr() as *const f32;
@@ -194,15 +199,19 @@ pub(in crate::preserving) unsafe fn dog_step_avx2(
             // SAFETY: as in `preserving_lanes_avx2`, for both kernels (the excitatory one
             // reaches less far into the padded row).
             unsafe {
-                if block == 10 {
-                    pixel_row_block::<10>(e, first_i, ki, fi, oi, x0);
-                    pixel_row_block::<10>(e, first_e, ke, fe, oe, x0);
-                } else if wide {
-                    pixel_row_block::<8>(e, first_i, ki, fi, oi, x0);
-                    pixel_row_block::<8>(e, first_e, ke, fe, oe, x0);
-                } else {
-                    pixel_row_block::<1>(e, first_i, ki, fi, oi, x0);
-                    pixel_row_block::<1>(e, first_e, ke, fe, oe, x0);
+                match block {
+                    10 => {
+                        pixel_row_block::<10>(e, first_i, ki, fi, oi, x0);
+                        pixel_row_block::<10>(e, first_e, ke, fe, oe, x0);
+                    }
+                    8 => {
+                        pixel_row_block::<8>(e, first_i, ki, fi, oi, x0);
+                        pixel_row_block::<8>(e, first_e, ke, fe, oe, x0);
+                    }
+                    _ => {
+                        pixel_row_block::<1>(e, first_i, ki, fi, oi, x0);
+                        pixel_row_block::<1>(e, first_e, ke, fe, oe, x0);
+                    }
                 }
             }
             x = x0 + block;
@@ -220,12 +229,10 @@ pub(in crate::preserving) unsafe fn dog_step_avx2(
             // SAFETY: every tap's row is below h (checked above) and x0 + block <= w; the
             // pixels below `x` are done and not competed again.
             unsafe {
-                if block == 10 {
-                    dog_pixels::<10>((te, ti), stride, (&re[y], &ri[y]), row, x0, x, (cv, z));
-                } else if wide {
-                    dog_pixels::<8>((te, ti), stride, (&re[y], &ri[y]), row, x0, x, (cv, z));
-                } else {
-                    dog_pixels::<1>((te, ti), stride, (&re[y], &ri[y]), row, x0, x, (cv, z));
+                match block {
+                    10 => dog_pixels::<10>((te, ti), stride, (&re[y], &ri[y]), row, x0, x, (cv, z)),
+                    8 => dog_pixels::<8>((te, ti), stride, (&re[y], &ri[y]), row, x0, x, (cv, z)),
+                    _ => dog_pixels::<1>((te, ti), stride, (&re[y], &ri[y]), row, x0, x, (cv, z)),
                 }
             }
             x = x0 + block;
